@@ -1,0 +1,39 @@
+# Short names for the README's commands. Every target installs what it needs first (idempotent).
+.PHONY: all deps build test test-asan test-debug rt clean help
+
+all: build
+
+help:
+	@echo "make test       install dependencies, configure, build and run every test (release preset)"
+	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
+	@echo "make test-debug the same without optimisation (build/debug)"
+	@echo "make build      build only (binaries in build/bin)"
+	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
+	@echo "make clean      remove build/"
+
+deps:
+	@bash toolchain/install-deps.sh
+
+build: deps
+	cmake --preset release
+	cmake --build --preset release
+
+test: build
+	ctest --preset release
+
+test-asan: deps
+	cmake --preset asan
+	cmake --build --preset asan
+	ctest --preset asan
+
+test-debug: deps
+	cmake --preset debug
+	cmake --build --preset debug
+	ctest --preset debug
+
+rt: deps
+	cmake --preset rt-x86_64
+	cmake --build --preset rt-x86_64
+
+clean:
+	rm -rf build

@@ -1,0 +1,106 @@
+// The tool's 14-DOP at a pose: holds the whole tool, and is as tight as the envelope allows.
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include <Eigen/Geometry>
+
+#include "firmware/geometry/tool_bound.hpp"
+#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "tests/support/sample_tools.hpp"
+#include "tests/support/tool_profile_reference.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil::geometry;
+using stencil::test::kSampleTools;
+using stencil::test::ToolProfileReference;
+
+namespace {
+
+struct Pose {
+  Eigen::Vector3d tip;
+  Eigen::Vector3d axis;
+  Eigen::Matrix3d rotation;  // tool frame to world
+};
+
+Pose random_pose(std::mt19937_64& rng) {
+  std::normal_distribution<double> gaussian(0.0, 1.0);
+  std::uniform_real_distribution<double> position(-50.0, 50.0);
+  const Eigen::Vector3d axis = Eigen::Vector3d(gaussian(rng), gaussian(rng), gaussian(rng)).normalized();
+  return {{position(rng), position(rng), position(rng)},
+          axis,
+          Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix()};
+}
+
+ToolEnvelope envelope_of(const ToolSpec& spec) {
+  ToolBsp tool{};
+  CHECK(build_tool_bsp(spec, tool).ok);
+  return tool.envelope;
+}
+
+}  // namespace
+
+TEST_GROUP(ToolBound){};
+
+TEST(ToolBound, HoldsEveryPointOfTheToolAtRandomPoses) {
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const auto& sample : kSampleTools) {
+    const ToolEnvelope envelope = envelope_of(sample.spec);
+    const ToolProfileReference reference(sample.spec);
+    for (int trial = 0; trial < 200; ++trial) {
+      const Pose pose = random_pose(rng);
+      const Kdop14 volume = tool_kdop(envelope, pose.tip, pose.axis);
+      for (int i = 0; i < 200; ++i) {
+        // Surface points (the outermost there are) and interior points.
+        auto point = reference.surface_point(unit(rng), unit(rng));
+        if (i % 2 == 1) {
+          point.r *= unit(rng);
+        }
+        const double angle = 2 * std::numbers::pi * unit(rng);
+        const Eigen::Vector3d local(point.r * std::cos(angle), point.r * std::sin(angle), point.z);
+        CHECK_TEXT(volume.contains(pose.tip + pose.rotation * local, 1e-9), sample.name);
+      }
+    }
+  }
+}
+
+TEST(ToolBound, IsTheEnvelopeBoxForAnUprightTool) {
+  const ToolEnvelope envelope = envelope_of(kSampleTools[0].spec);  // flat d3 l12 under d10 l20
+  const Kdop14 volume = tool_kdop(envelope, {1.0, 2.0, 3.0}, Eigen::Vector3d::UnitZ());
+  DOUBLES_EQUAL(1.0 - 5.0, volume.min[0], 1e-12);
+  DOUBLES_EQUAL(1.0 + 5.0, volume.max[0], 1e-12);
+  DOUBLES_EQUAL(2.0 - 5.0, volume.min[1], 1e-12);
+  DOUBLES_EQUAL(2.0 + 5.0, volume.max[1], 1e-12);
+  DOUBLES_EQUAL(3.0, volume.min[2], 1e-12);
+  DOUBLES_EQUAL(3.0 + 32.0, volume.max[2], 1e-12);
+  // Along (1,1,1): the tip's rim reaches 1 + 2 + 3 - 1.5 * sqrt(2) at the lowest.
+  DOUBLES_EQUAL(6.0 - 1.5 * std::sqrt(2.0), volume.min[3], 1e-12);
+}
+
+TEST(ToolBound, EachBoundIsReachedByTheEnvelope) {
+  // Tight: for every slab, some point on the envelope's rims lies on the bound (to sampling accuracy).
+  std::mt19937_64 rng(22);
+  const ToolEnvelope envelope = envelope_of(kSampleTools[5].spec);
+  for (int trial = 0; trial < 100; ++trial) {
+    const Pose pose = random_pose(rng);
+    const Kdop14 volume = tool_kdop(envelope, pose.tip, pose.axis);
+    Kdop14 rims = Kdop14::empty();
+    const double rim_heights[] = {0.0, envelope.flute_length_mm, envelope.flute_length_mm, envelope.total_length_mm};
+    const double rim_radii[] = {envelope.cutter_radius_mm, envelope.cutter_radius_mm, envelope.holder_radius_mm,
+                                envelope.holder_radius_mm};
+    for (int rim = 0; rim < 4; ++rim) {
+      for (int step = 0; step < 3600; ++step) {
+        const double angle = 2 * std::numbers::pi * step / 3600.0;
+        const Eigen::Vector3d local(rim_radii[rim] * std::cos(angle), rim_radii[rim] * std::sin(angle), rim_heights[rim]);
+        rims.add(pose.tip + pose.rotation * local);
+      }
+    }
+    for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+      DOUBLES_EQUAL(volume.min[slab], rims.min[slab], 1e-5);
+      DOUBLES_EQUAL(volume.max[slab], rims.max[slab], 1e-5);
+    }
+  }
+}

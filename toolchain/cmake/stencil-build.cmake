@@ -1,0 +1,35 @@
+# Shared build rules: warnings for the project's own code, the real-time core's flags, the core library helper.
+
+# Warnings are errors in the project's own code; third-party headers come in as SYSTEM includes.
+add_library(stencil_warnings INTERFACE)
+target_compile_options(stencil_warnings INTERFACE
+  -Wall -Wextra -Wpedantic -Wconversion -Wsign-conversion -Wshadow
+  -Wnon-virtual-dtor -Wcast-align -Wnull-dereference -Wdouble-promotion
+  -Werror)
+
+# Results must not change with the compiler's choice to fuse multiply and add, in the core or in
+# the offline tools that share its geometry.
+add_compile_options(-ffp-contract=off)
+
+if(STENCIL_SANITIZE)
+  add_compile_options(-fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  add_link_options(-fsanitize=address,undefined)
+endif()
+
+# The 1 kHz core: no exceptions, no RTTI, and any dynamic Eigen allocation aborts.
+add_library(stencil_core_flags INTERFACE)
+target_compile_options(stencil_core_flags INTERFACE
+  $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti>)
+
+# stencil_core_library(NAME SOURCES...): a static library of the allocation-free core. It is
+# registered for the link-time check in linker/, which fails the build's tests if any of its
+# objects references the heap, exceptions, locks, stdio or blocking calls.
+function(stencil_core_library name)
+  add_library(${name} STATIC ${ARGN})
+  target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
+  # EIGEN_NO_MALLOC travels with the headers (one definition everywhere); the code-generation flags
+  # are the core's own.
+  target_compile_definitions(${name} PUBLIC EIGEN_NO_MALLOC)
+  target_link_libraries(${name} PUBLIC Eigen3::Eigen PRIVATE stencil_core_flags stencil_warnings)
+  set_property(GLOBAL APPEND PROPERTY STENCIL_CORE_LIBRARIES ${name})
+endfunction()

@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
+set -euo pipefail
+
+packages=(
+  g++                # host compiler (C++20)
+  cmake              # build system (presets need >= 3.21)
+  ninja-build        # generator used by every preset
+  make               # the thin top-level Makefile
+  libeigen3-dev      # fixed-size linear algebra in the core
+  libcpputest-dev    # unit tests
+  linux-libc-dev     # kernel headers: SocketCAN (linux/can.h)
+  binutils           # nm, for the link-time allocation check
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$package")
+  fi
+done
+
+if [ "${#missing[@]}" -eq 0 ]; then
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  sudo_cmd=()
+elif command -v sudo >/dev/null 2>&1; then
+  sudo_cmd=(sudo)
+else
+  echo "install-deps: need root or sudo to install: ${missing[*]}" >&2
+  exit 1
+fi
+
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
