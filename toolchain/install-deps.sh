@@ -1,6 +1,20 @@
 #!/usr/bin/env bash
 # Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
+# --cross also installs the aarch64-linux-gnu cross compiler for the `aarch64` preset.
 set -euo pipefail
+
+cross=0
+for argument in "$@"; do
+  case "$argument" in
+    --cross) cross=1 ;;
+    -h|--help)
+      echo "usage: $0 [--cross]"
+      echo "Installs the Debian packages the project needs (apt-get; as root or via sudo)."
+      echo "  --cross   also the aarch64-linux-gnu cross compiler (for the aarch64 preset)"
+      exit 0 ;;
+    *) echo "install-deps: unknown option '$argument' (expected --cross or --help)" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   g++                # host compiler (C++20)
@@ -12,6 +26,9 @@ packages=(
   linux-libc-dev     # kernel headers: SocketCAN (linux/can.h)
   binutils           # nm, for the link-time allocation check
 )
+if [ "$cross" -eq 1 ]; then
+  packages+=(g++-aarch64-linux-gnu)
+fi
 
 missing=()
 for package in "${packages[@]}"; do
