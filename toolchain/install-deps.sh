@@ -25,6 +25,10 @@ packages=(
   libcpputest-dev    # unit tests
   linux-libc-dev     # kernel headers: SocketCAN (linux/can.h)
   binutils           # nm, for the link-time allocation check
+  zlib1g-dev         # CRC-32 of the table files
+  nettle-dev         # SHA-256 of the source STL in the table header
+  libcli11-dev       # the table generator's command line
+  nlohmann-json3-dev # --inspect --json
 )
 if [ "$cross" -eq 1 ]; then
   packages+=(g++-aarch64-linux-gnu)

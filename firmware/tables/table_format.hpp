@@ -1,0 +1,176 @@
+// The .stbl table file: byte layout of the header and of every section, shared by the table
+// generator (writer) and the firmware loader (reader). A layout change breaks the build here.
+//
+// File layout (all integers and floats little-endian, IEEE-754):
+//   [0, 512)        TableHeader
+//   sections        each at an offset that is a multiple of 64, in the order of TableSection,
+//                   with zero bytes between them; the header's section table gives offset and size.
+//     Tool          ToolSection: the tool's BSP tree as built from the header's tool spec
+//     Points        PackedPoint[point_count]: world millimetres, in BVH leaf order
+//     Normals       PackedPoint[point_count]: unit outward normal of each point's triangle
+//     TriangleIds   uint32[point_count]: the triangle each point lies on
+//     PointFlags    uint8[point_count]: kPointReachable
+//     Triangles     PackedTriangle[triangle_count]: the part's mesh for display (world mm)
+//     TriangleFlags uint8[triangle_count]: kTriangleReachable
+//     Nodes         BvhNode[node_count]: binary 14-DOP tree over the points, depth-first
+//   crc32 (zlib's CRC-32) covers every byte from offset 20 (just after the crc32 field) to the end.
+#pragma once
+
+#include <bit>
+#include <cstddef>
+#include <cstdint>
+
+namespace stencil::tables {
+
+static_assert(std::endian::native == std::endian::little, "tables are read in place: little-endian hosts only");
+
+inline constexpr std::uint8_t kTableMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L', 'T'};
+inline constexpr std::uint32_t kTableFormatVersion = 1;
+inline constexpr std::size_t kSectionAlignment = 64;
+inline constexpr std::size_t kCrcStartOffset = 20;
+
+// Capacities the controller reserves for (static storage), and the most the generator writes.
+inline constexpr std::uint32_t kMaxTablePoints = 4'194'304;     // 2^22
+inline constexpr std::uint32_t kMaxTableTriangles = 2'097'152;  // 2^21
+// A median-split tree with at most kMaxLeafPoints per leaf has leaves of at least 17 points, so
+// fewer than 2 * points / 16 nodes; a table may hold smaller leaves, up to this many nodes.
+inline constexpr std::uint32_t kMaxTableNodes = kMaxTablePoints / 4;
+inline constexpr std::uint32_t kMaxLeafPoints = 32;
+// The loader walks the tree with a fixed stack: deeper trees are refused. A median split of
+// kMaxTablePoints points is 18 levels deep.
+inline constexpr std::uint32_t kMaxTreeDepth = 64;
+
+enum class TableSection : std::uint32_t {
+  Tool = 0,
+  Points,
+  Normals,
+  TriangleIds,
+  PointFlags,
+  Triangles,
+  TriangleFlags,
+  Nodes,
+  Count,
+};
+inline constexpr std::size_t kSectionCount = static_cast<std::size_t>(TableSection::Count);
+
+inline constexpr std::uint8_t kPointReachable = 1u << 0;     // a vertical tool can touch it legally
+inline constexpr std::uint8_t kTriangleReachable = 1u << 0;  // at least one of its points is reachable
+
+struct SectionEntry {
+  std::uint64_t offset;  // from the start of the file; a multiple of kSectionAlignment
+  std::uint64_t bytes;   // exactly count * element size
+};
+static_assert(sizeof(SectionEntry) == 16);
+
+struct TableHeader {
+  std::uint8_t magic[8];            // kTableMagic
+  std::uint32_t format_version;     // kTableFormatVersion
+  std::uint32_t header_bytes;       // sizeof(TableHeader)
+  std::uint32_t crc32;              // CRC-32 of bytes [kCrcStartOffset, file_bytes)
+  std::uint32_t flags;              // reserved, 0
+  std::uint64_t file_bytes;         // size of the whole file
+  std::uint32_t triangle_count;
+  std::uint32_t point_count;
+  std::uint32_t node_count;
+  std::uint32_t vertex_point_count;  // how many of the points are mesh vertices (the rest: centroids, samples)
+  SectionEntry sections[kSectionCount];
+  double covering_radius_mm;         // achieved: every surface point is within this of a sample
+  double requested_spacing_mm;       // h asked for (directly or from --max-gouge)
+  double gouge_bound_mm;             // deepest the tool can dip between samples at the achieved spacing
+  double allowance_mm;               // stencil inflated by this finishing allowance
+  double part_min_mm[3];             // bounds of the points, world frame
+  double part_max_mm[3];
+  double workspace_mm[3];            // the box [0,X]x[0,Y]x[0,Z] the part was placed in
+  double stl_to_world_scale;         // world mm per STL unit (units times --scale)
+  std::uint64_t seed;                // --seed for the extra random points
+  std::uint64_t extra_points;        // --extra-points
+  std::uint32_t tool_kind;           // geometry::CutterKind
+  std::uint32_t reserved0;
+  double tool_diameter_mm;
+  double tool_flute_length_mm;
+  double tool_corner_radius_mm;
+  double tool_holder_diameter_mm;
+  double tool_holder_length_mm;
+  std::uint8_t source_sha256[32];    // SHA-256 of the source STL file
+  std::uint64_t source_bytes;        // size of the source STL file
+  std::uint32_t source_triangle_count;     // triangles read from the STL
+  std::uint32_t dropped_degenerate_count;  // zero-area triangles dropped
+  std::uint32_t reachable_point_count;
+  std::uint32_t reachable_triangle_count;
+  std::uint8_t reserved[104];
+};
+static_assert(sizeof(TableHeader) == 512, "the header is 512 bytes");
+static_assert(offsetof(TableHeader, crc32) == 16 && offsetof(TableHeader, flags) == kCrcStartOffset);
+static_assert(offsetof(TableHeader, sections) == 48);
+static_assert(offsetof(TableHeader, covering_radius_mm) == 176);
+static_assert(offsetof(TableHeader, tool_kind) == 304);
+static_assert(offsetof(TableHeader, source_sha256) == 352);
+static_assert(offsetof(TableHeader, reserved) == 408);
+
+struct PackedPoint {
+  float x_mm;
+  float y_mm;
+  float z_mm;
+};
+static_assert(sizeof(PackedPoint) == 12);
+
+struct PackedTriangle {
+  PackedPoint vertices[3];  // counter-clockwise seen from outside (right-hand rule gives the outward normal)
+};
+static_assert(sizeof(PackedTriangle) == 36);
+
+// One node of the points' tree. Internal nodes (point_count == 0) have their left child right
+// after them and their right child at right_child; leaves hold points [first_point, first_point + point_count).
+struct BvhNode {
+  double dop_min[7];  // geometry::Kdop14 of everything below, slab order of kKdopSlabDirections
+  double dop_max[7];
+  std::uint32_t first_point;
+  std::uint32_t point_count;
+  std::uint32_t right_child;
+  std::uint32_t reserved;
+};
+static_assert(sizeof(BvhNode) == 128);
+static_assert(offsetof(BvhNode, first_point) == 112);
+
+// The tool's BSP tree in the file: the fields of geometry::ToolBsp, each byte defined.
+struct ToolSectionSurface {
+  std::uint8_t kind;        // geometry::SurfaceKind
+  std::int8_t solid_side;   // geometry::SolidSide
+  std::uint8_t reserved[6];
+  double center_r_mm;
+  double center_z_mm;
+  double radius_mm;
+};
+static_assert(sizeof(ToolSectionSurface) == 32);
+
+struct ToolSectionNode {
+  std::uint8_t test;  // geometry::NodeTest
+  std::uint8_t surface_a;
+  std::uint8_t surface_b;
+  std::uint8_t when_true_kind;  // geometry::BspLink::Kind
+  std::uint8_t when_true_index;
+  std::uint8_t when_false_kind;
+  std::uint8_t when_false_index;
+  std::uint8_t reserved;
+};
+static_assert(sizeof(ToolSectionNode) == 8);
+
+struct ToolSectionRegion {
+  std::uint8_t surface;
+  std::uint8_t face;  // geometry::ToolFace
+  std::uint8_t reserved[2];
+};
+static_assert(sizeof(ToolSectionRegion) == 4);
+
+struct ToolSection {
+  std::uint32_t surface_count;
+  std::uint32_t node_count;
+  std::uint32_t region_count;
+  std::uint32_t reserved;
+  ToolSectionSurface surfaces[16];
+  ToolSectionNode nodes[32];
+  ToolSectionRegion regions[8];
+};
+static_assert(sizeof(ToolSection) == 16 + 16 * 32 + 32 * 8 + 8 * 4);
+
+}  // namespace stencil::tables

@@ -1,0 +1,119 @@
+// Median-split 14-DOP tree; node positions are known in advance, so subtrees build independently.
+#include "toolchain/tablegen/bvh_builder.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+#include <numeric>
+#include <thread>
+
+#include "firmware/geometry/kdop14.hpp"
+
+namespace stencil::tablegen {
+namespace {
+
+using geometry::kKdopSlabCount;
+
+constexpr std::array<double, kKdopSlabCount> kSlabLength = {1.0, 1.0, 1.0, 1.7320508075688772, 1.7320508075688772,
+                                                            1.7320508075688772, 1.7320508075688772};
+
+Eigen::Vector3d to_vector(const tables::PackedPoint& point) { return {point.x_mm, point.y_mm, point.z_mm}; }
+
+class TreeBuilder {
+ public:
+  TreeBuilder(const std::vector<tables::PackedPoint>& points, PointTree& tree) : points_(points), tree_(tree) {}
+
+  // Builds the subtree over order[begin, end) into nodes starting at node_index.
+  void build(std::uint32_t node_index, std::uint32_t begin, std::uint32_t end) {
+    geometry::Kdop14 volume = geometry::Kdop14::empty();
+    for (std::uint32_t i = begin; i < end; ++i) {
+      volume.add(to_vector(points_[tree_.order[i]]));
+    }
+    tables::BvhNode& node = tree_.nodes[node_index];
+    std::memset(&node, 0, sizeof(node));
+    std::copy(volume.min.begin(), volume.min.end(), node.dop_min);
+    std::copy(volume.max.begin(), volume.max.end(), node.dop_max);
+    const std::uint32_t count = end - begin;
+    if (count <= tables::kMaxLeafPoints) {
+      node.first_point = begin;
+      node.point_count = count;
+      return;
+    }
+    const std::uint32_t middle = split(volume, begin, end);
+    const std::uint32_t left = node_index + 1;
+    const std::uint32_t right = left + static_cast<std::uint32_t>(point_tree_node_count(middle - begin));
+    node.right_child = right;
+    build(left, begin, middle);
+    build(right, middle, end);
+  }
+
+  // Orders order[begin, end) so the lower half along the widest slab comes first; returns the middle.
+  std::uint32_t split(const geometry::Kdop14& volume, std::uint32_t begin, std::uint32_t end) {
+    std::size_t widest = 0;
+    double widest_extent = -1.0;
+    for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+      const double extent = (volume.max[slab] - volume.min[slab]) / kSlabLength[slab];
+      if (extent > widest_extent) {
+        widest_extent = extent;
+        widest = slab;
+      }
+    }
+    const std::uint32_t middle = begin + (end - begin) / 2;
+    const auto& direction = geometry::kKdopSlabDirections[widest];
+    const auto key = [&](std::uint32_t index) {
+      const tables::PackedPoint& point = points_[index];
+      const double projection = direction[0] * double{point.x_mm} + direction[1] * double{point.y_mm} +
+                                direction[2] * double{point.z_mm};
+      return std::make_pair(projection, index);
+    };
+    // Ties broken by index make the halves well defined; nth_element is deterministic, so the same
+    // build of the generator gives the same order every time.
+    std::nth_element(tree_.order.begin() + begin, tree_.order.begin() + middle, tree_.order.begin() + end,
+                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+    return middle;
+  }
+
+ private:
+  const std::vector<tables::PackedPoint>& points_;
+  PointTree& tree_;
+};
+
+}  // namespace
+
+std::uint64_t point_tree_node_count(std::uint64_t count) {
+  if (count <= tables::kMaxLeafPoints) {
+    return 1;
+  }
+  const std::uint64_t half = count / 2;
+  return 1 + point_tree_node_count(half) + point_tree_node_count(count - half);
+}
+
+PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsigned threads) {
+  PointTree tree;
+  const auto count = static_cast<std::uint32_t>(points.size());
+  tree.order.resize(count);
+  std::iota(tree.order.begin(), tree.order.end(), 0u);
+  tree.nodes.resize(point_tree_node_count(count));
+  TreeBuilder builder(points, tree);
+  if (threads <= 1 || count <= tables::kMaxLeafPoints) {
+    builder.build(0, 0, count);
+    return tree;
+  }
+  // The root by hand, then its two subtrees side by side: they touch disjoint slots.
+  geometry::Kdop14 volume = geometry::Kdop14::empty();
+  for (const tables::PackedPoint& point : points) {
+    volume.add(to_vector(point));
+  }
+  const std::uint32_t middle = builder.split(volume, 0, count);
+  tables::BvhNode& root = tree.nodes[0];
+  std::memset(&root, 0, sizeof(root));
+  std::copy(volume.min.begin(), volume.min.end(), root.dop_min);
+  std::copy(volume.max.begin(), volume.max.end(), root.dop_max);
+  root.right_child = 1 + static_cast<std::uint32_t>(point_tree_node_count(middle));
+  std::thread left([&] { builder.build(1, 0, middle); });
+  builder.build(root.right_child, middle, count);
+  left.join();
+  return tree;
+}
+
+}  // namespace stencil::tablegen

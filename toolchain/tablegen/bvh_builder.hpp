@@ -1,0 +1,25 @@
+// Builds the binary 14-DOP tree over the points, in the table's depth-first layout.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "firmware/tables/table_format.hpp"
+
+namespace stencil::tablegen {
+
+struct PointTree {
+  std::vector<std::uint32_t> order;     // order[i]: which input point goes to table slot i
+  std::vector<tables::BvhNode> nodes;   // root first, depth-first
+};
+
+// Splits at the median along the slab of largest extent (ties broken by input index, so the
+// result is deterministic) until a node has at most kMaxLeafPoints points. The two halves of the
+// root are built on two threads when threads > 1; the result does not depend on `threads`.
+// The DOPs are computed from `points` exactly as given (the float values the table will hold).
+[[nodiscard]] PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsigned threads);
+
+// Nodes a tree over `count` points has (for capacity checks).
+[[nodiscard]] std::uint64_t point_tree_node_count(std::uint64_t count);
+
+}  // namespace stencil::tablegen

@@ -1,0 +1,54 @@
+// Assembles the .stbl bytes, writes them atomically, and emits them as C++ for a firmware image.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "firmware/geometry/tool_bsp.hpp"
+#include "firmware/tables/table_format.hpp"
+
+namespace stencil::tablegen {
+
+struct TableContents {
+  tables::TableHeader header;  // every descriptive field set; counts, sections, sizes and CRC are filled in
+  geometry::ToolBsp tool;
+  std::vector<tables::PackedPoint> points;
+  std::vector<tables::PackedPoint> normals;
+  std::vector<std::uint32_t> triangle_ids;
+  std::vector<std::uint8_t> point_flags;
+  std::vector<tables::PackedTriangle> triangles;
+  std::vector<std::uint8_t> triangle_flags;
+  std::vector<tables::BvhNode> nodes;
+};
+
+// Memory for a table, aligned as the loader needs it.
+class TableBytes {
+ public:
+  explicit TableBytes(std::size_t size = 0);
+  std::byte* data() { return storage_.data() + offset_; }
+  const std::byte* data() const { return storage_.data() + offset_; }
+  std::size_t size() const { return size_; }
+
+ private:
+  std::vector<std::byte> storage_;
+  std::size_t offset_ = 0;
+  std::size_t size_ = 0;
+};
+
+// Lays the table out (header, then 64-byte aligned sections) and seals it with the CRC-32.
+[[nodiscard]] TableBytes assemble_table(TableContents& contents);
+
+// Writes to a temporary file beside `path`, then renames it over `path`: no partial file is left
+// behind on any failure. Throws InputError naming the path.
+void write_file_atomically(const std::string& path, const TableBytes& bytes);
+
+// Writes DIR/<name>.cpp: the same bytes as a constant array in section ".stencil_tables"
+// (see linker/stencil_tables.ld), with the symbols <name> and <name>_size.
+void emit_cpp(const std::string& directory, const std::string& name, const TableBytes& bytes);
+
+// Reads a whole file into aligned memory; throws InputError naming the path.
+[[nodiscard]] TableBytes read_table_file(const std::string& path);
+
+}  // namespace stencil::tablegen
