@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
-# --cross also installs the aarch64-linux-gnu cross compiler for the `aarch64` preset.
+# --cross also installs the aarch64-linux-gnu cross compiler and the arm64 libraries the firmware
+# links (zlib), for the `aarch64` preset.
 set -euo pipefail
 
 cross=0
@@ -31,7 +32,7 @@ packages=(
   nlohmann-json3-dev # --inspect --json
 )
 if [ "$cross" -eq 1 ]; then
-  packages+=(g++-aarch64-linux-gnu)
+  packages+=(g++-aarch64-linux-gnu zlib1g-dev:arm64)
 fi
 
 missing=()
@@ -56,5 +57,8 @@ else
 fi
 
 export DEBIAN_FRONTEND=noninteractive
+if [ "$cross" -eq 1 ] && ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  "${sudo_cmd[@]}" dpkg --add-architecture arm64
+fi
 "${sudo_cmd[@]}" apt-get update -q
 "${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"

@@ -32,7 +32,9 @@ Kdop14 tool_kdop(const ToolEnvelope& envelope, const Eigen::Vector3d& tip_mm, co
   const Eigen::Vector3d holder_top = tip_mm + envelope.total_length_mm * unit_axis;
   add_cylinder(volume, tip_mm, flute_top, unit_axis, envelope.cutter_radius_mm);
   add_cylinder(volume, flute_top, holder_top, unit_axis, envelope.holder_radius_mm);
-  return volume;
+  // Grown by twice the surface tolerance: everything the BSP may call touching is inside, and so is
+  // the rounding of the projections above.
+  return volume.enlarged(kToolBoundMargin_mm);
 }
 
 }  // namespace stencil::geometry

@@ -11,17 +11,36 @@ namespace {
 // Below this radius the radial direction of a point is numerically meaningless.
 constexpr double kOnAxisRadius_mm = 1e-12;
 
-bool evaluate(const ToolBsp& tool, const BspNode& node, MeridianPoint point) {
+enum class Branch : std::uint8_t { True, False, Invalid };
+
+// A NaN anywhere (in the point or in the tree's numbers) is a fault, never a quiet "outside".
+Branch evaluate(const ToolBsp& tool, const BspNode& node, MeridianPoint point) {
   const ImplicitSurface& a = tool.surfaces[node.surface_a];
+  double left = 0.0;
+  double right = 0.0;
   switch (node.test) {
     case NodeTest::InsideBoundary:
-      return interior_distance(a, point) >= -kSurfaceTolerance_mm;
+      left = -kSurfaceTolerance_mm;
+      right = interior_distance(a, point);
+      break;
     case NodeTest::BelowPartition:
-      return surface_function(a, point) < 0.0;
+      left = surface_function(a, point);
+      right = 0.0;
+      if (std::isnan(left)) {
+        return Branch::Invalid;
+      }
+      return left < right ? Branch::True : Branch::False;
     case NodeTest::NearerThan:
-      return interior_distance(a, point) <= interior_distance(tool.surfaces[node.surface_b], point);
+      left = interior_distance(a, point);
+      right = interior_distance(tool.surfaces[node.surface_b], point);
+      break;
+    default:
+      return Branch::Invalid;
   }
-  return false;
+  if (std::isnan(left) || std::isnan(right)) {
+    return Branch::Invalid;
+  }
+  return left <= right ? Branch::True : Branch::False;
 }
 
 MeridianClassification bad_tree() {
@@ -38,7 +57,8 @@ Eigen::Vector3d any_perpendicular(const Eigen::Vector3d& unit_axis) {
 }  // namespace
 
 MeridianClassification classify_meridian(const ToolBsp& tool, MeridianPoint point) {
-  if (tool.node_count == 0 || tool.node_count > kMaxToolNodes) {
+  if (tool.node_count == 0 || tool.node_count > kMaxToolNodes || tool.surface_count > kMaxToolSurfaces ||
+      tool.region_count > kMaxToolRegions || !std::isfinite(point.r_mm) || !std::isfinite(point.z_mm)) {
     return bad_tree();
   }
   std::size_t node_index = 0;
@@ -50,7 +70,11 @@ MeridianClassification classify_meridian(const ToolBsp& tool, MeridianPoint poin
         (node.test == NodeTest::NearerThan && node.surface_b >= tool.surface_count)) {
       return bad_tree();
     }
-    const BspLink link = evaluate(tool, node, point) ? node.when_true : node.when_false;
+    const Branch branch = evaluate(tool, node, point);
+    if (branch == Branch::Invalid) {
+      return bad_tree();
+    }
+    const BspLink link = branch == Branch::True ? node.when_true : node.when_false;
     switch (link.kind) {
       case BspLink::Kind::Outside:
         return {PointContact::Outside, 0, 0.0, {0.0, 0.0}};
@@ -61,17 +85,23 @@ MeridianClassification classify_meridian(const ToolBsp& tool, MeridianPoint poin
         const ImplicitSurface& surface = tool.surfaces[tool.regions[link.index].surface];
         const double depth = interior_distance(surface, point);
         const MeridianDirection escape = escape_direction(surface, point);
+        if (!std::isfinite(depth) || !std::isfinite(escape.radial) || !std::isfinite(escape.axial)) {
+          return bad_tree();
+        }
         if (depth > kSurfaceTolerance_mm) {
           return {PointContact::Penetrating, link.index, depth, escape};
         }
         return {PointContact::Touching, link.index, 0.0, escape};
       }
       case BspLink::Kind::Node:
+        // Forward only: a backward link could reach a region by a path the tree never meant.
         if (link.index <= node_index || link.index >= tool.node_count) {
           return bad_tree();
         }
         node_index = link.index;
         break;
+      default:
+        return bad_tree();
     }
   }
   return bad_tree();

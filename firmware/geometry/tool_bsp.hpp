@@ -19,8 +19,9 @@ inline constexpr std::size_t kMaxToolSurfaces = 16;
 inline constexpr std::size_t kMaxToolNodes = 32;
 inline constexpr std::size_t kMaxToolRegions = 8;
 
-// A point within this distance of the tool's surface (inside, or outside by rounding) is touching
-// with depth 0: only depth beyond it is penetration.
+// A point inside the tool by no more than this is touching with depth 0: only depth beyond it is
+// penetration. Points outside by about this much (up to sqrt(2) times it at a rim, where two
+// boundary tests each allow it) may also be reported as touching; points farther out never are.
 inline constexpr double kSurfaceTolerance_mm = 1e-9;
 
 // Which face of the tool a region's points are nearest to (for display and diagnostics).
@@ -95,7 +96,8 @@ enum class PointContact : std::uint8_t {
   Outside,      // not in the tool
   Touching,     // on the tool's surface (within kSurfaceTolerance_mm): depth 0, no force
   Penetrating,  // inside the tool by depth_mm > 0
-  BadTree,      // the tree's links are broken (an unchecked table); treat as a fault
+  BadTree,      // the tree is damaged (broken links, counts beyond capacity, NaN numbers) or the
+                // point is not finite: treat as a fault, never as "no contact"
 };
 
 struct PointClassification {

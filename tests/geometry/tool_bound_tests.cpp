@@ -61,7 +61,7 @@ TEST(ToolBound, HoldsEveryPointOfTheToolAtRandomPoses) {
         }
         const double angle = 2 * std::numbers::pi * unit(rng);
         const Eigen::Vector3d local(point.r * std::cos(angle), point.r * std::sin(angle), point.z);
-        CHECK_TEXT(volume.contains(pose.tip + pose.rotation * local, 1e-9), sample.name);
+        CHECK_TEXT(volume.contains(pose.tip + pose.rotation * local), sample.name);
       }
     }
   }
@@ -70,14 +70,28 @@ TEST(ToolBound, HoldsEveryPointOfTheToolAtRandomPoses) {
 TEST(ToolBound, IsTheEnvelopeBoxForAnUprightTool) {
   const ToolEnvelope envelope = envelope_of(kSampleTools[0].spec);  // flat d3 l12 under d10 l20
   const Kdop14 volume = tool_kdop(envelope, {1.0, 2.0, 3.0}, Eigen::Vector3d::UnitZ());
-  DOUBLES_EQUAL(1.0 - 5.0, volume.min[0], 1e-12);
-  DOUBLES_EQUAL(1.0 + 5.0, volume.max[0], 1e-12);
-  DOUBLES_EQUAL(2.0 - 5.0, volume.min[1], 1e-12);
-  DOUBLES_EQUAL(2.0 + 5.0, volume.max[1], 1e-12);
-  DOUBLES_EQUAL(3.0, volume.min[2], 1e-12);
-  DOUBLES_EQUAL(3.0 + 32.0, volume.max[2], 1e-12);
+  const double margin = kToolBoundMargin_mm;
+  DOUBLES_EQUAL(1.0 - 5.0 - margin, volume.min[0], 1e-12);
+  DOUBLES_EQUAL(1.0 + 5.0 + margin, volume.max[0], 1e-12);
+  DOUBLES_EQUAL(2.0 - 5.0 - margin, volume.min[1], 1e-12);
+  DOUBLES_EQUAL(2.0 + 5.0 + margin, volume.max[1], 1e-12);
+  DOUBLES_EQUAL(3.0 - margin, volume.min[2], 1e-12);
+  DOUBLES_EQUAL(3.0 + 32.0 + margin, volume.max[2], 1e-12);
   // Along (1,1,1): the tip's rim reaches 1 + 2 + 3 - 1.5 * sqrt(2) at the lowest.
-  DOUBLES_EQUAL(6.0 - 1.5 * std::sqrt(2.0), volume.min[3], 1e-12);
+  DOUBLES_EQUAL(6.0 - 1.5 * std::sqrt(2.0) - margin * std::sqrt(3.0), volume.min[3], 1e-12);
+}
+
+TEST(ToolBound, HoldsEveryPointTheToolCallsTouching) {
+  // Just outside the bottom face and the rim: the BSP may call these touching, so the bound must hold them.
+  ToolBsp tool{};
+  CHECK(build_tool_bsp(kSampleTools[1].spec, tool).ok);  // flat d6, shank of its own diameter
+  const Eigen::Vector3d tip(1.0, 2.0, 3.0);
+  const Kdop14 volume = tool_kdop(tool.envelope, tip, Eigen::Vector3d::UnitZ());
+  const Eigen::Vector3d near_points[] = {{0.5, 0.0, -0.9e-9}, {3.0 + 0.7e-9, 0.0, -0.7e-9}, {0.0, 3.0 + 0.9e-9, 1.0}};
+  for (const Eigen::Vector3d& local : near_points) {
+    CHECK(classify_in_tool_frame(tool, local).contact == PointContact::Touching);
+    CHECK(volume.contains(tip + local));
+  }
 }
 
 TEST(ToolBound, EachBoundIsReachedByTheEnvelope) {
@@ -99,8 +113,8 @@ TEST(ToolBound, EachBoundIsReachedByTheEnvelope) {
       }
     }
     for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-      DOUBLES_EQUAL(volume.min[slab], rims.min[slab], 1e-5);
-      DOUBLES_EQUAL(volume.max[slab], rims.max[slab], 1e-5);
+      DOUBLES_EQUAL(volume.min[slab], rims.min[slab] - kToolBoundMargin_mm * (slab < 3 ? 1.0 : std::sqrt(3.0)), 1e-5);
+      DOUBLES_EQUAL(volume.max[slab], rims.max[slab] + kToolBoundMargin_mm * (slab < 3 ? 1.0 : std::sqrt(3.0)), 1e-5);
     }
   }
 }

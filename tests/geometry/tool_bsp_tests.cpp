@@ -1,6 +1,8 @@
 // The tool BSP against an independent outline: inside/outside, exact depth, escape direction, continuity.
 #include <cmath>
 #include <cstdint>
+#include <limits>
+#include <utility>
 #include <numbers>
 #include <random>
 
@@ -92,7 +94,11 @@ TEST(ToolBsp, DepthIsTheExactDistanceToTheToolSurface) {
       const PointClassification result = classify_in_tool_frame(tool, point);
       const double expected = reference_distance(reference, point);
       DOUBLES_EQUAL_TEXT(expected, result.depth_mm, 1e-9, sample.name);
-      CHECK_TEXT(result.contact == (expected > 2e-9 ? PointContact::Penetrating : result.contact), sample.name);
+      if (expected > 2 * kSurfaceTolerance_mm) {
+        CHECK_TEXT(result.contact == PointContact::Penetrating, sample.name);
+      } else if (expected < 0.5 * kSurfaceTolerance_mm) {
+        CHECK_TEXT(result.contact == PointContact::Touching, sample.name);
+      }
     }
   }
 }
@@ -189,6 +195,8 @@ TEST(ToolBsp, PointsOnTheSurfaceTouchWithZeroDepth) {
 TEST(ToolBsp, PenetratesOnlyBeyondTheSurfaceTolerance) {
   const ToolBsp tool = build(kSampleTools[0].spec);  // flat d3: bottom at z = 0
   CHECK(classify_in_tool_frame(tool, {0.1, 0.0, -1e-6}).contact == PointContact::Outside);
+  CHECK(classify_in_tool_frame(tool, {0.1, 0.0, -2 * kSurfaceTolerance_mm}).contact == PointContact::Outside);
+  CHECK(classify_in_tool_frame(tool, {0.1, 0.0, 2 * kSurfaceTolerance_mm}).contact == PointContact::Penetrating);
   CHECK(classify_in_tool_frame(tool, {0.1, 0.0, 0.5 * kSurfaceTolerance_mm}).contact == PointContact::Touching);
   const PointClassification just_in = classify_in_tool_frame(tool, {0.1, 0.0, 1e-6});
   CHECK(just_in.contact == PointContact::Penetrating);
@@ -235,6 +243,55 @@ TEST(ToolBsp, ClassifyingAtAPoseMatchesTheToolFrame) {
   }
 }
 
+TEST(ToolBsp, EscapeIsStillTheFastestWayOutAtTheCentreOfABallOrCornerTube) {
+  // Where the gradient is undefined the fallback direction must still lower depth at rate 1.
+  const ToolBsp ball = build(kSampleTools[2].spec);  // ball d3: sphere centre at z = 1.5 on the axis
+  const ToolBsp bull = build(kSampleTools[5].spec);  // bull d6 r1: corner tube centre at r = 2, z = 1
+  constexpr double step = 1e-4;
+  for (const auto& [tool, centre] : {std::pair{&ball, Eigen::Vector3d(0.0, 0.0, 1.5)},
+                                     std::pair{&bull, Eigen::Vector3d(2.0, 0.0, 1.0)}}) {
+    const PointClassification at_centre = classify_in_tool_frame(*tool, centre);
+    CHECK(at_centre.contact == PointContact::Penetrating);
+    DOUBLES_EQUAL(1.0, at_centre.escape_direction.norm(), 1e-12);
+    DOUBLES_EQUAL(at_centre.depth_mm - step, depth_at(*tool, centre + step * at_centre.escape_direction), 1e-9);
+  }
+}
+
+TEST(ToolBsp, EscapeIsRadialEvenVeryNearTheAxis) {
+  const ToolBsp tool = build(kSampleTools[1].spec);  // flat d6 l3, shank d6 l3: the side is nearest at mid-height
+  for (const double r : {1e-6, 1e-9}) {
+    const PointClassification result = classify_in_tool_frame(tool, {0.0, r, 3.0});
+    CHECK(result.contact == PointContact::Penetrating);
+    CHECK((result.escape_direction - Eigen::Vector3d(0.0, 1.0, 0.0)).norm() < 1e-12);
+  }
+}
+
+TEST(ToolBsp, APointThatIsNotANumberIsAFaultNotOutside) {
+  const ToolBsp tool = build(kSampleTools[0].spec);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(classify_in_tool_frame(tool, {nan, 0.0, 5.0}).contact == PointContact::BadTree);
+  CHECK(classify_in_tool_frame(tool, {0.0, 0.0, nan}).contact == PointContact::BadTree);
+  CHECK(classify_in_tool_frame(tool, {std::numeric_limits<double>::infinity(), 0.0, 5.0}).contact ==
+        PointContact::BadTree);
+  CHECK(classify_at_pose(tool, {0.0, 0.0, 0.0}, {nan, 0.0, 1.0}, {0.5, 0.0, 5.0}).contact == PointContact::BadTree);
+}
+
+TEST(ToolBsp, ANumberInTheTreeThatIsNotANumberIsAFault) {
+  const ToolBsp good = build(kSampleTools[0].spec);  // flat d3 l12 under d10 l20
+  const Eigen::Vector3d deep_inside(0.5, 0.0, 5.0);
+  for (std::size_t surface = 0; surface < good.surface_count; ++surface) {
+    ToolBsp damaged = good;
+    damaged.surfaces[surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
+    damaged.surfaces[surface].center_z_mm = std::numeric_limits<double>::quiet_NaN();
+    const PointContact contact = classify_in_tool_frame(damaged, deep_inside).contact;
+    // Either the damaged surface is on this point's path (a fault), or the answer is unchanged.
+    CHECK(contact == PointContact::BadTree || contact == classify_in_tool_frame(good, deep_inside).contact);
+  }
+  ToolBsp flute_side_nan = good;
+  flute_side_nan.surfaces[1].radius_mm = std::numeric_limits<double>::quiet_NaN();  // the flutes' cylinder
+  CHECK(classify_in_tool_frame(flute_side_nan, deep_inside).contact == PointContact::BadTree);
+}
+
 TEST(ToolBsp, ABrokenTreeIsReportedNotWalkedForever) {
   ToolBsp tool = build(kSampleTools[0].spec);
   ToolBsp looping = tool;
@@ -255,4 +312,29 @@ TEST(ToolBsp, ABrokenTreeIsReportedNotWalkedForever) {
   ToolBsp bad_region = tool;
   bad_region.region_count = 0;
   CHECK(classify_in_tool_frame(bad_region, {0.1, 0.0, 1.0}).contact == PointContact::BadTree);
+
+  // Counts beyond the arrays' capacity must not lead to reading past them.
+  ToolBsp too_many_surfaces = tool;
+  too_many_surfaces.surface_count = 255;
+  too_many_surfaces.nodes[0].surface_a = 200;
+  CHECK(classify_in_tool_frame(too_many_surfaces, {0.1, 0.0, 1.0}).contact == PointContact::BadTree);
+  ToolBsp too_many_nodes = tool;
+  too_many_nodes.node_count = kMaxToolNodes + 1;
+  CHECK(classify_in_tool_frame(too_many_nodes, {0.1, 0.0, 1.0}).contact == PointContact::BadTree);
+  ToolBsp too_many_regions = tool;
+  too_many_regions.region_count = kMaxToolRegions + 1;
+  CHECK(classify_in_tool_frame(too_many_regions, {0.1, 0.0, 1.0}).contact == PointContact::BadTree);
+
+  // A backward link that reaches a region (not a loop) is refused too, not followed.
+  ToolBsp backward = tool;
+  const std::size_t last = backward.node_count - 1;
+  backward.nodes[last].when_true = {BspLink::Kind::Node, 1};
+  backward.nodes[last].when_false = {BspLink::Kind::Node, 1};
+  int refused = 0;
+  for (double r = 0.25; r < 5.0; r += 0.5) {
+    for (double z = 0.5; z < 32.0; z += 0.5) {
+      refused += classify_in_tool_frame(backward, {r, 0.0, z}).contact == PointContact::BadTree ? 1 : 0;
+    }
+  }
+  CHECK(refused > 0);
 }

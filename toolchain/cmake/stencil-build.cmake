@@ -22,8 +22,9 @@ target_compile_options(stencil_core_flags INTERFACE
   $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti>)
 
 # stencil_core_library(NAME SOURCES...): a static library of the allocation-free core. It is
-# registered for the link-time check in linker/, which fails the build's tests if any of its
-# objects references the heap, exceptions, locks, stdio or blocking calls.
+# checked right after it is built (every preset, cross builds included, with that toolchain's nm)
+# and again by the ctest in linker/: the build fails if any of its objects references the heap,
+# exceptions, locks, stdio or blocking calls.
 function(stencil_core_library name)
   add_library(${name} STATIC ${ARGN})
   target_include_directories(${name} PUBLIC ${PROJECT_SOURCE_DIR})
@@ -32,4 +33,8 @@ function(stencil_core_library name)
   target_compile_definitions(${name} PUBLIC EIGEN_NO_MALLOC)
   target_link_libraries(${name} PUBLIC Eigen3::Eigen PRIVATE stencil_core_flags stencil_warnings)
   set_property(GLOBAL APPEND PROPERTY STENCIL_CORE_LIBRARIES ${name})
+  add_custom_command(TARGET ${name} POST_BUILD
+    COMMAND ${CMAKE_COMMAND} -E env NM=${CMAKE_NM} ${PROJECT_SOURCE_DIR}/linker/check-no-alloc.sh $<TARGET_FILE:${name}>
+    COMMENT "Checking ${name} for heap, exceptions, locks, stdio and blocking calls"
+    VERBATIM)
 endfunction()

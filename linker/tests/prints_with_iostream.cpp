@@ -1,0 +1,3 @@
+// Breaks the rule on purpose: writes with iostreams.
+#include <iostream>
+void report(int value) { std::cout << value << '\n'; }
