@@ -113,17 +113,15 @@ std::vector<Facet> tessellated_dome(std::size_t triangles, double x0_mm, double 
   return facets;
 }
 
-void write_stl(const std::string& path, const std::vector<Facet>& facets, bool binary, const std::string& solid_name) {
-  std::ofstream file(path, std::ios::binary);
-  if (!file) {
-    throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
-  }
+std::vector<std::byte> encode_stl(const std::vector<Facet>& facets, bool binary, const std::string& solid_name) {
+  std::string bytes;
+  const auto append = [&](const void* data, std::size_t size) { bytes.append(static_cast<const char*>(data), size); };
   if (binary) {
     char header[80] = {};
     std::snprintf(header, sizeof(header), "binary STL written by stencil-sample-parts: %s", solid_name.c_str());
-    file.write(header, sizeof(header));
+    append(header, sizeof(header));
     const auto count = static_cast<std::uint32_t>(facets.size());
-    file.write(reinterpret_cast<const char*>(&count), sizeof(count));
+    append(&count, sizeof(count));
     for (const Facet& facet : facets) {
       const Eigen::Vector3d normal = (facet[1] - facet[0]).cross(facet[2] - facet[0]).normalized();
       float values[12];
@@ -133,9 +131,9 @@ void write_stl(const std::string& path, const std::vector<Facet>& facets, bool b
           values[3 + 3 * vertex + axis] = static_cast<float>(facet[static_cast<std::size_t>(vertex)][axis]);
         }
       }
-      file.write(reinterpret_cast<const char*>(values), sizeof(values));
+      append(values, sizeof(values));
       const std::uint16_t attributes = 0;
-      file.write(reinterpret_cast<const char*>(&attributes), sizeof(attributes));
+      append(&attributes, sizeof(attributes));
     }
   } else {
     std::ostringstream text;
@@ -150,8 +148,20 @@ void write_stl(const std::string& path, const std::vector<Facet>& facets, bool b
       text << "    endloop\n  endfacet\n";
     }
     text << "endsolid " << solid_name << "\n";
-    file << text.str();
+    bytes = text.str();
   }
+  std::vector<std::byte> result(bytes.size());
+  std::memcpy(result.data(), bytes.data(), bytes.size());
+  return result;
+}
+
+void write_stl(const std::string& path, const std::vector<Facet>& facets, bool binary, const std::string& solid_name) {
+  const std::vector<std::byte> bytes = encode_stl(facets, binary, solid_name);
+  std::ofstream file(path, std::ios::binary);
+  if (!file) {
+    throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
+  }
+  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
   if (!file.flush()) {
     throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
   }

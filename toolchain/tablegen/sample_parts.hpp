@@ -26,6 +26,9 @@ std::vector<Facet> thin_fin(double length_mm, double thickness_mm, double height
 std::vector<Facet> tessellated_dome(std::size_t triangles, double x0_mm, double y0_mm, double width_mm,
                                     double depth_mm, double base_mm, double bump_mm);
 
+// The bytes of an ASCII (named `solid_name`) or binary STL of the facets.
+std::vector<std::byte> encode_stl(const std::vector<Facet>& facets, bool binary, const std::string& solid_name);
+
 // Writes facets as ASCII (named `solid_name`) or binary STL; throws InputError naming the path.
 void write_stl(const std::string& path, const std::vector<Facet>& facets, bool binary, const std::string& solid_name);
 
