@@ -38,15 +38,19 @@ void add_box(std::vector<Facet>& facets, const Eigen::Vector3d& low, const Eigen
 }  // namespace
 
 std::vector<Facet> hexagonal_prism(double circumradius_mm, double height_mm, double cx_mm, double cy_mm) {
+  // Each corner computed once, so neighbouring facets share exactly equal vertices (a closed mesh).
+  std::array<Eigen::Vector3d, 6> corners;
+  for (std::size_t i = 0; i < 6; ++i) {
+    const double angle = std::numbers::pi / 3.0 * static_cast<double>(i);
+    corners[i] = {cx_mm + circumradius_mm * std::cos(angle), cy_mm + circumradius_mm * std::sin(angle), 0.0};
+  }
   std::vector<Facet> facets;
   const Eigen::Vector3d bottom_centre(cx_mm, cy_mm, 0.0);
   const Eigen::Vector3d top_centre(cx_mm, cy_mm, height_mm);
-  for (int i = 0; i < 6; ++i) {
-    const double a0 = std::numbers::pi / 3.0 * i;
-    const double a1 = std::numbers::pi / 3.0 * (i + 1);
-    const Eigen::Vector3d p0(cx_mm + circumradius_mm * std::cos(a0), cy_mm + circumradius_mm * std::sin(a0), 0.0);
-    const Eigen::Vector3d p1(cx_mm + circumradius_mm * std::cos(a1), cy_mm + circumradius_mm * std::sin(a1), 0.0);
-    const Eigen::Vector3d up(0.0, 0.0, height_mm);
+  const Eigen::Vector3d up(0.0, 0.0, height_mm);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const Eigen::Vector3d& p0 = corners[i];
+    const Eigen::Vector3d& p1 = corners[(i + 1) % 6];
     facets.push_back({bottom_centre, p1, p0});          // bottom, facing down
     facets.push_back({top_centre, p0 + up, p1 + up});   // top, facing up
     add_quad(facets, p0, p1, p1 + up, p0 + up);         // side, facing out
@@ -56,15 +60,34 @@ std::vector<Facet> hexagonal_prism(double circumradius_mm, double height_mm, dou
 
 std::vector<Facet> slotted_block(double length_mm, double width_mm, double height_mm, double slot_width_mm,
                                  double slot_depth_mm, double x_mm, double y_mm) {
-  // The block is three boxes sharing faces would leave internal faces; instead build it as two
-  // walls and a floor slab whose outer skin is watertight enough for the demo (shared faces are
-  // reported as non-manifold-free open edges by the generator, which is the point of a sample).
-  std::vector<Facet> facets;
+  // A U-shaped cross-section in the (y, z) plane, counter-clockwise, extruded along x: one closed
+  // solid with no internal faces.
   const double wall = 0.5 * (width_mm - slot_width_mm);
   const double floor = height_mm - slot_depth_mm;
-  add_box(facets, {x_mm, y_mm, 0.0}, {x_mm + length_mm, y_mm + width_mm, floor});
-  add_box(facets, {x_mm, y_mm, floor}, {x_mm + length_mm, y_mm + wall, height_mm});
-  add_box(facets, {x_mm, y_mm + wall + slot_width_mm, floor}, {x_mm + length_mm, y_mm + width_mm, height_mm});
+  const std::array<std::array<double, 2>, 8> outline = {{{0.0, 0.0},
+                                                         {width_mm, 0.0},
+                                                         {width_mm, height_mm},
+                                                         {width_mm - wall, height_mm},
+                                                         {width_mm - wall, floor},
+                                                         {wall, floor},
+                                                         {wall, height_mm},
+                                                         {0.0, height_mm}}};
+  const auto at = [&](std::size_t corner, double x) {
+    return Eigen::Vector3d(x, y_mm + outline[corner][0], outline[corner][1]);
+  };
+  const double x0 = x_mm;
+  const double x1 = x_mm + length_mm;
+  std::vector<Facet> facets;
+  // The end caps: the U cut into six triangles (right wall, floor slab, left wall).
+  const std::array<std::array<std::size_t, 3>, 6> cap = {{{1, 2, 3}, {1, 3, 4}, {0, 1, 4}, {0, 4, 5}, {0, 5, 6}, {0, 6, 7}}};
+  for (const auto& triangle : cap) {
+    facets.push_back({at(triangle[0], x1), at(triangle[1], x1), at(triangle[2], x1)});  // facing +x
+    facets.push_back({at(triangle[0], x0), at(triangle[2], x0), at(triangle[1], x0)});  // facing -x
+  }
+  for (std::size_t i = 0; i < outline.size(); ++i) {
+    const std::size_t next = (i + 1) % outline.size();
+    add_quad(facets, at(i, x0), at(next, x0), at(next, x1), at(i, x1));
+  }
   return facets;
 }
 
