@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt clean help
+.PHONY: all deps build test test-asan test-debug rt fuzz clean help
 
 all: build
 
@@ -9,6 +9,7 @@ help:
 	@echo "make test-debug the same without optimisation (build/debug)"
 	@echo "make build      build only (binaries in build/bin)"
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
+	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
 
 deps:
@@ -34,6 +35,13 @@ test-debug: deps
 rt: deps
 	cmake --preset rt-x86_64
 	cmake --build --preset rt-x86_64
+
+# Each fuzz target runs for FUZZ_SECONDS (both at once, one per core): `make fuzz FUZZ_SECONDS=600` for a long run.
+FUZZ_SECONDS ?= 60
+fuzz: deps
+	cmake --preset fuzz -DSTENCIL_FUZZ_SECONDS=$(FUZZ_SECONDS)
+	cmake --build --preset fuzz
+	ctest --preset fuzz
 
 clean:
 	rm -rf build
