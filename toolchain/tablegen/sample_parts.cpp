@@ -132,7 +132,7 @@ std::vector<Facet> tessellated_dome(std::size_t triangles, double x0_mm, double 
     add_quad(facets, floor_of(top(0, j + 1)), floor_of(top(0, j)), top(0, j), top(0, j + 1));
     add_quad(facets, floor_of(top(n, j)), floor_of(top(n, j + 1)), top(n, j + 1), top(n, j));
   }
-  add_quad(facets, floor_of(top(0, 0)), floor_of(top(0, m)), floor_of(top(n, m)), floor_of(top(n, 0)));
+  // No bottom: it stands on the stock floor, which is never cut (the mesh is open there).
   return facets;
 }
 

@@ -21,8 +21,8 @@ std::vector<Facet> slotted_block(double length_mm, double width_mm, double heigh
 // A thin upright fin (a plate) standing on z = 0.
 std::vector<Facet> thin_fin(double length_mm, double thickness_mm, double height_mm, double x_mm, double y_mm);
 
-// A smooth closed dome-like height field over a rectangle, with about `triangles` facets: the
-// benchmark's finely tessellated surface (top surface, four walls and the bottom).
+// A smooth dome-like height field over a rectangle, with about `triangles` facets: the
+// benchmark's finely tessellated surface (top and four walls; open at the bottom, on the floor).
 std::vector<Facet> tessellated_dome(std::size_t triangles, double x0_mm, double y0_mm, double width_mm,
                                     double depth_mm, double base_mm, double bump_mm);
 

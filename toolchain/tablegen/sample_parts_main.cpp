@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   using namespace stencil::tablegen;
   const std::string usage =
       "usage: stencil-sample-parts DIR            write hex_prism.stl, slotted_block.stl, thin_fin.stl into DIR\n"
-      "       stencil-sample-parts --dome N FILE  write a closed, finely tessellated dome of about N facets (binary)\n";
+      "       stencil-sample-parts --dome N FILE  write a finely tessellated dome of about N facets (binary; open at the bottom)\n";
   try {
     if (argc == 2 && std::string(argv[1]) != "--help" && std::string(argv[1]) != "-h") {
       const std::string directory = argv[1];
