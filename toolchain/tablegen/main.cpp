@@ -38,13 +38,13 @@ class Progress {
       return;
     }
     last_ = now;
-    std::fprintf(stderr, "\r%-14s %5.1f%%", phase, 100.0 * fraction);
+    std::fprintf(stderr, "\rstencil-tablegen: %-14s %5.1f%%", phase, 100.0 * fraction);
     shown_ = true;
   }
 
   void finish() {
     if (shown_) {
-      std::fprintf(stderr, "\r%-24s\r", "");
+      std::fprintf(stderr, "\r%-48s\r", "");
       shown_ = false;
     }
   }

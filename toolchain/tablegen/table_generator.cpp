@@ -115,12 +115,14 @@ void check_options(const GeneratorOptions& options) {
 TableContents generate_tables(std::span<const std::byte> stl_bytes, const std::string& file_name,
                               const GeneratorOptions& options, GeneratorReport& report, const ProgressSink& progress) {
   check_options(options);
+  progress("reading STL", 0.0);
   const StlMesh stl = parse_stl(stl_bytes, file_name);
   if (stl.triangles.size() > tables::kMaxTableTriangles) {
     throw InputError(file_name + ": " + std::to_string(stl.triangles.size()) +
                      " triangles, more than the controller's capacity of " +
                      std::to_string(tables::kMaxTableTriangles) + "; simplify the mesh");
   }
+  progress("checking mesh", 0.0);
   const PartMesh mesh = prepare_part(stl, options.placement, file_name);
   report.mesh = mesh.report;
   collect_warnings(file_name, options, mesh.report, report.warnings);
