@@ -181,8 +181,7 @@ int main(int argc, char** argv) {
       throw InputError("--emit-cpp " + emit_directory + ": not a directory");
     }
 
-    std::vector<std::byte> stl_bytes;
-    static_cast<void>(read_stl_file(part_path, stl_bytes));  // reads and checks; parsed again below
+    const std::vector<std::byte> stl_bytes = read_file_bytes(part_path);
     GeneratorReport report;
     Progress progress(!quiet);
     TableContents contents = generate_tables(stl_bytes, part_path, options, report,

@@ -216,7 +216,7 @@ StlMesh parse_stl(std::span<const std::byte> bytes, const std::string& file_name
   return parse_ascii(bytes, file_name);
 }
 
-StlMesh read_stl_file(const std::string& path, std::vector<std::byte>& contents) {
+std::vector<std::byte> read_file_bytes(const std::string& path) {
   std::ifstream file(path, std::ios::binary);
   if (!file) {
     throw InputError(path + ": cannot open (" + std::strerror(errno) + ")");
@@ -227,11 +227,11 @@ StlMesh read_stl_file(const std::string& path, std::vector<std::byte>& contents)
     throw InputError(path + ": cannot read (not a regular file?)");
   }
   file.seekg(0, std::ios::beg);
-  contents.resize(static_cast<std::size_t>(size));
+  std::vector<std::byte> contents(static_cast<std::size_t>(size));
   if (size > 0 && !file.read(reinterpret_cast<char*>(contents.data()), size)) {
     throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
   }
-  return parse_stl(contents, path);
+  return contents;
 }
 
 }  // namespace stencil::tablegen

@@ -30,7 +30,7 @@ struct StlMesh {
 // Throws InputError naming the file and the facet (binary: with its byte offset) or line (ASCII).
 StlMesh parse_stl(std::span<const std::byte> bytes, const std::string& file_name);
 
-// Reads the whole file and parses it; InputError when it cannot be read.
-StlMesh read_stl_file(const std::string& path, std::vector<std::byte>& contents);
+// The whole file's bytes; InputError naming the path when it cannot be read.
+std::vector<std::byte> read_file_bytes(const std::string& path);
 
 }  // namespace stencil::tablegen
