@@ -1,6 +1,7 @@
 // Table inspection for people (a summary) and machines (--json).
 #include "toolchain/tablegen/inspect.hpp"
 
+#include <cmath>
 #include <iomanip>
 #include <ostream>
 #include <sstream>
@@ -34,6 +35,17 @@ std::string hex(const std::uint8_t* bytes, std::size_t count) {
   return text.str();
 }
 
+// Whole numbers (sizes, counts, CRCs) exactly; others with every digit that matters.
+std::string exact(double value) {
+  std::ostringstream text;
+  if (std::isfinite(value) && value == std::floor(value) && std::abs(value) < 9.007199254740992e15) {
+    text << static_cast<long long>(value);
+  } else {
+    text << std::setprecision(17) << value;
+  }
+  return text.str();
+}
+
 }  // namespace
 
 int inspect_table(const std::string& path, bool json, std::ostream& out, std::ostream& err) {
@@ -48,7 +60,7 @@ int inspect_table(const std::string& path, bool json, std::ostream& out, std::os
   const tables::TableLoadResult result = tables::load_tables({bytes.data(), bytes.size()}, part);
   if (!result.ok) {
     err << "stencil-tablegen: " << path << ": " << result.field << " (at " << result.index << "): expected "
-        << result.expected << "; found " << result.value << "\n";
+        << result.expected << "; found " << exact(result.value) << "\n";
     return 2;
   }
   const tables::TableHeader& header = part.header;

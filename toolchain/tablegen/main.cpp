@@ -12,6 +12,7 @@
 #include <CLI/CLI.hpp>
 
 #include "firmware/tables/table_format.hpp"
+#include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/inspect.hpp"
 #include "toolchain/tablegen/table_generator.hpp"
@@ -182,6 +183,14 @@ int main(int argc, char** argv) {
     }
 
     const std::vector<std::byte> stl_bytes = read_file_bytes(part_path);
+    // Outputs are opened before the work, so an unwritable place is refused at once; they appear
+    // only when everything has succeeded.
+    PendingFile table_file(output_path);
+    std::optional<PendingFile> cpp_file;
+    const std::string symbol = table_symbol(output_path);
+    if (!emit_directory.empty()) {
+      cpp_file.emplace(emit_directory + "/" + symbol + ".cpp");
+    }
     GeneratorReport report;
     Progress progress(!quiet);
     TableContents contents = generate_tables(stl_bytes, part_path, options, report,
@@ -191,9 +200,19 @@ int main(int argc, char** argv) {
       std::cerr << "stencil-tablegen: warning: " << warning << "\n";
     }
     const TableBytes bytes = assemble_table(contents);
-    write_file_atomically(output_path, bytes);
-    if (!emit_directory.empty()) {
-      emit_cpp(emit_directory, table_symbol(output_path), bytes);
+    table_file.write(bytes.data(), bytes.size());
+    if (cpp_file) {
+      const std::string source = table_as_cpp(symbol, bytes);
+      cpp_file->write(source.data(), source.size());
+      cpp_file->commit();
+    }
+    try {
+      table_file.commit();
+    } catch (const InputError&) {
+      if (cpp_file) {
+        std::filesystem::remove(cpp_file->path());  // all or nothing: no C++ without its table
+      }
+      throw;
     }
     const double seconds = std::chrono::duration<double>(Clock::now() - started).count();
     if (!quiet) {

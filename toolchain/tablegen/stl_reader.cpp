@@ -1,6 +1,7 @@
 // STL parsing: binary by size, ASCII by grammar, every number checked.
 #include "toolchain/tablegen/stl_reader.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <sstream>
 #include <string_view>
 
+#include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 
 namespace stencil::tablegen {
@@ -177,7 +179,23 @@ StlMesh parse_ascii(std::span<const std::byte> bytes, const std::string& file_na
   if (mesh.solid_count == 0) {
     throw InputError(file_name + ": line 1: expected 'solid'; the file is empty");
   }
+  if (mesh.triangles.empty()) {
+    throw InputError(file_name + ": the ASCII STL has no facets; expected at least one");
+  }
   return mesh;
+}
+
+// ASCII STL is printable text; a NUL or another control byte in the first kilobyte after the
+// 80-byte header means a binary file whose header happens to begin with "solid".
+bool looks_binary(std::span<const std::byte> bytes) {
+  const std::size_t end = std::min<std::size_t>(bytes.size(), kBinaryHeaderBytes + 1024);
+  for (std::size_t i = 80; i < end; ++i) {
+    const auto c = static_cast<unsigned char>(bytes[i]);
+    if (c < 0x20 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v') {
+      return true;
+    }
+  }
+  return false;
 }
 
 bool begins_with_solid(std::span<const std::byte> bytes) {
@@ -203,7 +221,7 @@ StlMesh parse_stl(std::span<const std::byte> bytes, const std::string& file_name
       }
       return parse_binary(bytes, count, file_name);
     }
-    if (!begins_with_solid(bytes)) {
+    if (!begins_with_solid(bytes) || looks_binary(bytes)) {
       throw InputError(file_name + ": binary STL header says " + std::to_string(count) + " triangles, which needs " +
                        std::to_string(kBinaryHeaderBytes + std::size_t{count} * kBinaryFacetBytes) +
                        " bytes, but the file has " + std::to_string(bytes.size()) +
@@ -217,6 +235,7 @@ StlMesh parse_stl(std::span<const std::byte> bytes, const std::string& file_name
 }
 
 std::vector<std::byte> read_file_bytes(const std::string& path) {
+  static_cast<void>(regular_file_size(path));  // refuses directories and missing files by name
   std::ifstream file(path, std::ios::binary);
   if (!file) {
     throw InputError(path + ": cannot open (" + std::strerror(errno) + ")");

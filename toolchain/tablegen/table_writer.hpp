@@ -40,13 +40,9 @@ class TableBytes {
 // Lays the table out (header, then 64-byte aligned sections) and seals it with the CRC-32.
 [[nodiscard]] TableBytes assemble_table(TableContents& contents);
 
-// Writes to a temporary file beside `path`, then renames it over `path`: no partial file is left
-// behind on any failure. Throws InputError naming the path.
-void write_file_atomically(const std::string& path, const TableBytes& bytes);
-
-// Writes DIR/<name>.cpp: the same bytes as a constant array in section ".stencil_tables"
-// (see linker/stencil_tables.ld), with the symbols <name> and <name>_size.
-void emit_cpp(const std::string& directory, const std::string& name, const TableBytes& bytes);
+// The table as a C++ source file: the same bytes as a constant array <name> in section
+// ".stencil_tables" (see linker/stencil_tables.ld), with its size in <name>_size.
+[[nodiscard]] std::string table_as_cpp(const std::string& name, const TableBytes& bytes);
 
 // Reads a whole file into aligned memory; throws InputError naming the path.
 [[nodiscard]] TableBytes read_table_file(const std::string& path);
