@@ -7,27 +7,16 @@
 
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/part_mesh.hpp"
+#include "tests/support/stl_meshes.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>
 
 using namespace stencil::tablegen;
+using stencil::test::mesh_of;
 
 namespace {
-
-StlMesh mesh_of(const std::vector<Facet>& facets) {
-  StlMesh mesh{StlFormat::Ascii, {}, 1};
-  for (const Facet& facet : facets) {
-    StlTriangle triangle;
-    for (std::size_t v = 0; v < 3; ++v) {
-      triangle.vertices[v] = facet[v];
-    }
-    triangle.file_normal = (facet[1] - facet[0]).cross(facet[2] - facet[0]).normalized();
-    mesh.triangles.push_back(triangle);
-  }
-  return mesh;
-}
 
 std::string error_of(const StlMesh& stl, const PlacementOptions& options) {
   try {

@@ -3,6 +3,7 @@
 #include <random>
 #include <vector>
 
+#include "tests/support/stl_meshes.hpp"
 #include "toolchain/tablegen/point_cloud.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
@@ -15,18 +16,7 @@ using stencil::geometry::ToolSpec;
 
 namespace {
 
-PartMesh mesh_of(const std::vector<Facet>& facets) {
-  StlMesh stl{StlFormat::Ascii, {}, 1};
-  for (const Facet& facet : facets) {
-    StlTriangle triangle;
-    for (std::size_t v = 0; v < 3; ++v) {
-      triangle.vertices[v] = facet[v];
-    }
-    triangle.file_normal.setZero();
-    stl.triangles.push_back(triangle);
-  }
-  return prepare_part(stl, {}, "part.stl");
-}
+PartMesh mesh_of(const std::vector<Facet>& facets) { return prepare_part(stencil::test::mesh_of(facets), {}, "part.stl"); }
 
 // Awkward triangles: acute, right, very obtuse (a sliver) and large.
 std::vector<Facet> awkward_facets() {

@@ -69,6 +69,17 @@ void check_refused(const tablegen::TableBytes& bytes, const char* field) {
 TEST_GROUP(TableLoader) {
   tablegen::TableBytes table = test::make_table(test::default_part(), test::default_job_options());
   const tablegen::TableBytes& valid_table() const { return table; }
+
+  // A copy of the valid table with its header changed and the CRC re-sealed must be refused for `field`.
+  template <typename Change>
+  void with_header(Change change, const char* field) const {
+    tablegen::TableBytes bytes = copy_of(table, table.size());
+    TableHeader header = header_of(bytes);
+    change(header);
+    put_header(bytes, header);
+    reseal(bytes);
+    check_refused(bytes, field);
+  }
 };
 
 TEST(TableLoader, AdoptsWhatTheGeneratorWrites) {
@@ -137,14 +148,6 @@ TEST(TableLoader, RefusesTheWrongMagicVersionOrHeaderSize) {
 }
 
 TEST(TableLoader, RefusesCountsBeyondCapacityOrDisagreeingWithSections) {
-  const auto with_header = [this](auto change, const char* field) {
-    tablegen::TableBytes bytes = copy_of(valid_table(), valid_table().size());
-    TableHeader header = header_of(bytes);
-    change(header);
-    put_header(bytes, header);
-    reseal(bytes);
-    check_refused(bytes, field);
-  };
   with_header([](TableHeader& h) { h.point_count = kMaxTablePoints + 1; }, "header.point_count");
   with_header([](TableHeader& h) { h.point_count = 0; }, "header.point_count");
   with_header([](TableHeader& h) { h.triangle_count = kMaxTableTriangles + 1; }, "header.triangle_count");
@@ -162,14 +165,6 @@ TEST(TableLoader, RefusesCountsBeyondCapacityOrDisagreeingWithSections) {
 }
 
 TEST(TableLoader, RefusesABadToolSpecOrATreeThatIsNotTheSpecs) {
-  const auto with_header = [this](auto change, const char* field) {
-    tablegen::TableBytes bytes = copy_of(valid_table(), valid_table().size());
-    TableHeader header = header_of(bytes);
-    change(header);
-    put_header(bytes, header);
-    reseal(bytes);
-    check_refused(bytes, field);
-  };
   with_header([](TableHeader& h) { h.tool_kind = 7; }, "header.tool_kind");
   with_header([](TableHeader& h) { h.tool_kind = 256; }, "header.tool_kind");  // would wrap to flat as a byte
   with_header([](TableHeader& h) { h.tool_diameter_mm = -3.0; }, "diameter_mm");

@@ -57,43 +57,37 @@ void parallel_for(std::size_t count, unsigned threads, const Work& work) {
   }
 }
 
+// Radius of the rounded edge that meets the surface first: the ball, or the bull-nose corner;
+// 0 for a flat end mill's sharp corner.
+double rounded_edge_radius(const geometry::ToolSpec& tool) {
+  switch (tool.kind) {
+    case geometry::CutterKind::Ball:
+      return tool.diameter_mm / 2.0;
+    case geometry::CutterKind::BullNose:
+      return tool.corner_radius_mm;
+    case geometry::CutterKind::Flat:
+      break;
+  }
+  return 0.0;
+}
+
 }  // namespace
 
 double gouge_bound_mm(const geometry::ToolSpec& tool, double covering_radius_mm) {
   const double h = covering_radius_mm;
-  double rounded_radius = 0.0;
-  switch (tool.kind) {
-    case geometry::CutterKind::Flat:
-      return h;
-    case geometry::CutterKind::Ball:
-      rounded_radius = tool.diameter_mm / 2.0;
-      break;
-    case geometry::CutterKind::BullNose:
-      rounded_radius = tool.corner_radius_mm;
-      break;
+  const double r = rounded_edge_radius(tool);
+  if (h >= r) {
+    return h;  // a sharp corner, or samples sparser than the rounding: the edge acts as a corner
   }
-  if (h >= rounded_radius) {
-    return h;  // samples sparser than the rounding: the edge acts as a sharp corner
-  }
-  return rounded_radius - std::sqrt(rounded_radius * rounded_radius - h * h);
+  return r - std::sqrt(r * r - h * h);
 }
 
 double covering_radius_for_gouge(const geometry::ToolSpec& tool, double max_gouge_mm) {
-  double rounded_radius = 0.0;
-  switch (tool.kind) {
-    case geometry::CutterKind::Flat:
-      return max_gouge_mm;
-    case geometry::CutterKind::Ball:
-      rounded_radius = tool.diameter_mm / 2.0;
-      break;
-    case geometry::CutterKind::BullNose:
-      rounded_radius = tool.corner_radius_mm;
-      break;
-  }
-  if (max_gouge_mm >= rounded_radius) {
+  const double r = rounded_edge_radius(tool);
+  if (max_gouge_mm >= r) {
     return max_gouge_mm;
   }
-  return std::sqrt(max_gouge_mm * (2.0 * rounded_radius - max_gouge_mm));
+  return std::sqrt(max_gouge_mm * (2.0 * r - max_gouge_mm));
 }
 
 std::uint64_t count_cloud_points(const PartMesh& mesh, const CloudOptions& options) {
