@@ -1,0 +1,119 @@
+// The contact query on the default part: force along the face normal with magnitude k*d, none in
+// free space, legality, and touched triangles marked at the tool's pose.
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Geometry>
+
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/support/sample_tables.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::engine;
+
+namespace {
+
+// The default part: a hexagonal prism (circumradius 8, height 6) centred at (25, 12.5) with a
+// corner towards +x; its top face is z = 6 and one side face has the outward normal (cos 30, sin 30, 0)
+// at the apothem 8 cos 30 deg from the axis.
+constexpr double kTop_mm = 6.0;
+const double kApothem_mm = 8.0 * std::cos(3.14159265358979323846 / 6.0);
+const Eigen::Vector3d kSideNormal(std::cos(3.14159265358979323846 / 6.0), 0.5, 0.0);
+
+ToolPose upright_at(double x, double y, double tip_z) { return {{x, y, tip_z}, Eigen::Vector3d::UnitZ()}; }
+
+// The cloud samples the surface to the covering radius, so a rounded tool can sit up to the
+// table's gouge bound deeper than the deepest sample shows.
+void check_depth(const tables::PartTables& part, double true_depth, const ContactResult& result) {
+  CHECK(result.max_depth_mm <= true_depth + 1e-5);
+  CHECK(result.max_depth_mm >= true_depth - part.header.gouge_bound_mm - 1e-5);
+}
+
+}  // namespace
+
+TEST_GROUP(ContactQuery) {
+  tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options());
+  tables::PartTables part{};
+  ContactParameters parameters{};
+  void setup() override { CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok); }
+};
+
+TEST(ContactQuery, NoForceInFreeSpace) {
+  const ContactResult result = query_contacts(part, upright_at(25.0, 12.5, kTop_mm + 0.5), parameters);
+  CHECK(result.status == QueryStatus::Ok);
+  LONGS_EQUAL(0, result.penetrating_points);
+  DOUBLES_EQUAL(0.0, result.force_n.norm(), 0.0);
+  CHECK(check_legal(part, upright_at(25.0, 12.5, kTop_mm + 0.5)) == Legality::Legal);
+}
+
+TEST(ContactQuery, PressingIntoTheTopPushesStraightUpWithKTimesTheDeviceDepth) {
+  for (const double depth : {0.01, 0.05, 0.2}) {
+    const ContactResult result = query_contacts(part, upright_at(25.3, 12.1, kTop_mm - depth), parameters);
+    CHECK(result.status == QueryStatus::Ok);
+    CHECK(result.penetrating_points > 0);
+    check_depth(part, depth, result);
+    // k = 1 N per device mm; the device moves 10 mm per world mm.
+    DOUBLES_EQUAL(10.0 * result.max_depth_mm, result.force_n.norm(), 1e-9);
+    CHECK(result.force_n.normalized().dot(Eigen::Vector3d::UnitZ()) > 0.999);
+    CHECK(check_legal(part, upright_at(25.3, 12.1, kTop_mm - depth)) == Legality::Illegal);
+  }
+}
+
+TEST(ContactQuery, StiffnessDoesNotGrowWithTheNumberOfPointsInContact) {
+  // A deeper press brings many more points into contact; the force still follows depth alone.
+  const ContactResult shallow = query_contacts(part, upright_at(25.3, 12.1, kTop_mm - 0.02), parameters);
+  const ContactResult deep = query_contacts(part, upright_at(25.3, 12.1, kTop_mm - 0.4), parameters);
+  CHECK(deep.penetrating_points > 4 * shallow.penetrating_points);
+  DOUBLES_EQUAL(10.0 * shallow.max_depth_mm, shallow.force_n.norm(), 1e-9);
+  DOUBLES_EQUAL(10.0 * deep.max_depth_mm, deep.force_n.norm(), 1e-9);
+}
+
+TEST(ContactQuery, PressingSidewaysIntoAFacePushesAlongItsNormal) {
+  // The tool's side (radius 1.5) against the side face, 0.1 mm in, its tip at z = 2.
+  const double depth = 0.1;
+  const Eigen::Vector3d axis_at = Eigen::Vector3d(25.0, 12.5, 2.0) + (kApothem_mm + 1.5 - depth) * kSideNormal;
+  const ContactResult result = query_contacts(part, upright_at(axis_at.x(), axis_at.y(), 2.0), parameters);
+  CHECK(result.penetrating_points > 0);
+  check_depth(part, depth, result);
+  CHECK(result.force_n.normalized().dot(kSideNormal) > 0.999);
+  // The contact is below the compliance centre (10 mm up the axis): the push at the bottom turns
+  // the tool about the horizontal axis z x n, negatively.
+  CHECK(result.torque_nmm.dot(Eigen::Vector3d::UnitZ().cross(kSideNormal)) < 0.0);
+}
+
+TEST(ContactQuery, TouchingIsLegalAndExactlyTheSameQueryGivesTheSameBits) {
+  CHECK(check_legal(part, upright_at(25.3, 12.1, kTop_mm + 1e-6)) == Legality::Legal);
+  const ContactResult a = query_contacts(part, upright_at(25.31, 12.17, kTop_mm - 0.13), parameters);
+  const ContactResult b = query_contacts(part, upright_at(25.31, 12.17, kTop_mm - 0.13), parameters);
+  CHECK(a.force_n == b.force_n);
+  CHECK(a.torque_nmm == b.torque_nmm);
+  LONGS_EQUAL(a.penetrating_points, b.penetrating_points);
+}
+
+TEST(ContactQuery, APoseThatIsNotANumberIsRefusedNotAnswered) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(query_contacts(part, upright_at(nan, 12.5, 3.0), parameters).status == QueryStatus::BadInput);
+  CHECK(query_contacts(part, {{25.0, 12.5, 3.0}, {0.0, 0.0, 2.0}}, parameters).status == QueryStatus::BadInput);
+  CHECK(check_legal(part, upright_at(25.0, nan, 3.0)) == Legality::Fault);
+}
+
+TEST(ContactQuery, TouchedTrianglesAreThoseNearTheToolOnly) {
+  geometry::ToolBsp contact_tool{};
+  CHECK(build_contact_tool(part.tool.spec, 0.01, contact_tool));
+  TriangleSet touched;
+  // Resting on the top face: only top facets can be touched.
+  CHECK(mark_touched(part, contact_tool, upright_at(25.3, 12.1, kTop_mm + 0.001), 0.01, touched) > 0);
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    if (touched.contains(t)) {
+      const auto& v = part.triangles[t].vertices;
+      CHECK(v[0].z_mm == 6.0f && v[1].z_mm == 6.0f && v[2].z_mm == 6.0f);
+    }
+  }
+  // Hovering 0.05 mm above: nothing.
+  TriangleSet none;
+  LONGS_EQUAL(0, mark_touched(part, contact_tool, upright_at(25.3, 12.1, kTop_mm + 0.05), 0.01, none));
+}
