@@ -1,0 +1,64 @@
+// Remediation: the virtual tool, the only pose ever sent to the machine, kept legal every cycle.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/tables/part_tables.hpp"
+
+namespace stencil::engine {
+
+// Bounds on the work of one cycle, and the slip's step beyond the surface.
+inline constexpr int kMaxSlipIterations = 8;
+inline constexpr int kMaxSweepSteps = 64;
+inline constexpr double kSlipClearance_mm = 0.001;  // a slip ends 1 um clear of the surface, not on it
+
+enum class RemediationStatus : std::uint8_t {
+  Followed,      // the desired pose was legal and reached by a legal sweep
+  Slipped,       // the desired pose was illegal; the tool slid to a legal pose near it
+  Blocked,       // the straight path is blocked (a thin wall): advanced to the last legal sub-step
+  Stuck,         // nothing legal was found, or the path is blocked right here: the tool stayed
+  SweepLimited,  // the move was longer than the cycle may check: advanced as far as checked
+  Fault,         // bad input or damaged tables: the tool stayed, treat as a fault
+};
+
+struct RemediationResult {
+  RemediationStatus status;
+  Eigen::Vector3d tip_mm;     // the virtual tool's tip after this cycle (axis is +z)
+  int slip_iterations;
+  int sweep_steps;
+};
+
+// The virtual tool of a 3-axis mill: the axis is always +z; only the tip moves. Legal means no
+// point of the cloud deeper than the surface tolerance inside the tool, the tip not below the
+// stock floor (z = 0), and the tip inside the workspace box.
+class VirtualTool {
+ public:
+  // `home_tip_mm` must itself be legal (the machine's homed pose, above the part).
+  VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm);
+
+  // One cycle: moves towards `desired_tip_mm` as far as legality allows. Allocation-free, bounded
+  // by kMaxSlipIterations queries and kMaxSweepSteps legality checks per sweep.
+  RemediationResult step(const Eigen::Vector3d& desired_tip_mm, const ContactParameters& parameters);
+
+  [[nodiscard]] const Eigen::Vector3d& tip_mm() const { return tip_; }
+  [[nodiscard]] ToolPose pose() const { return {tip_, Eigen::Vector3d::UnitZ()}; }
+  // Longest sub-step of a sweep: half the tables' achieved point spacing.
+  [[nodiscard]] double sweep_step_mm() const { return sweep_step_; }
+
+ private:
+  enum class Sweep : std::uint8_t { Legal, Illegal, Limited, Fault };
+  [[nodiscard]] bool inside_box(const Eigen::Vector3d& tip) const;
+  [[nodiscard]] Eigen::Vector3d clamp_to_box(const Eigen::Vector3d& tip) const;
+  [[nodiscard]] Legality legal(const Eigen::Vector3d& tip) const;
+  Sweep sweep(const Eigen::Vector3d& to, Eigen::Vector3d& reached, int& steps) const;
+
+  const tables::PartTables& part_;
+  Eigen::Vector3d tip_;
+  Eigen::Vector3d box_high_;
+  double sweep_step_;
+};
+
+}  // namespace stencil::engine
