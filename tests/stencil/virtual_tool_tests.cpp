@@ -1,0 +1,189 @@
+// The virtual tool against an independent oracle: whatever the device does, the ball end mill never
+// cuts into the true part surface by more than the table's undetectable-gouge bound.
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "firmware/stencil/haptic_force.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/support/sample_tables.hpp"
+#include "tests/support/triangle_distance.hpp"
+#include "toolchain/tablegen/sample_parts.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::engine;
+
+namespace {
+
+const Eigen::Vector3d kHome(25.0, 12.5, 20.0);  // above every sample part
+
+// How deep the ball end mill at `tip` cuts into the true triangles (0 when it does not): the
+// cutter is a capsule of radius R around the axis from tip + R to the top of the flutes.
+double true_gouge_mm(const tables::PartTables& part, const Eigen::Vector3d& tip) {
+  const double radius = part.tool.envelope.cutter_radius_mm;
+  const Eigen::Vector3d low = tip + Eigen::Vector3d(0, 0, radius);
+  const Eigen::Vector3d high = tip + Eigen::Vector3d(0, 0, part.tool.envelope.flute_length_mm);
+  double deepest = 0.0;
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    const auto& v = part.triangles[t].vertices;
+    const auto vertex = [&](int i) { return Eigen::Vector3d(v[i].x_mm, v[i].y_mm, v[i].z_mm); };
+    const double distance = test::segment_triangle_distance(low, high, vertex(0), vertex(1), vertex(2));
+    deepest = std::max(deepest, radius - distance);
+  }
+  return deepest;
+}
+
+struct Loaded {
+  tablegen::TableBytes bytes;
+  tables::PartTables part{};
+  explicit Loaded(const std::vector<tablegen::Facet>& facets)
+      : bytes(test::make_table(facets, test::default_job_options(2))) {
+    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+  }
+};
+
+// Drives the virtual tool through `path` and checks every cycle against the oracle.
+void check_never_gouges(const tables::PartTables& part, const std::vector<Eigen::Vector3d>& path, double& worst) {
+  VirtualTool tool(part, kHome);
+  const ContactParameters parameters{};
+  for (const Eigen::Vector3d& desired : path) {
+    const RemediationResult result = tool.step(desired, parameters);
+    CHECK(result.status != RemediationStatus::Fault);
+    CHECK(check_legal(part, tool.pose()) == Legality::Legal);
+    CHECK(tool.tip_mm().z() >= 0.0);
+    const double gouge = true_gouge_mm(part, tool.tip_mm());
+    worst = std::max(worst, gouge);
+    CHECK(gouge <= part.header.gouge_bound_mm + 1e-5);
+  }
+}
+
+std::vector<Eigen::Vector3d> random_walk(std::mt19937_64& random, int cycles, double step_mm) {
+  std::normal_distribution<double> gaussian(0.0, 1.0);
+  std::uniform_real_distribution<double> box(0.0, 1.0);
+  std::vector<Eigen::Vector3d> path;
+  Eigen::Vector3d at(50.0 * box(random), 25.0 * box(random), 10.0 * box(random));
+  for (int i = 0; i < cycles; ++i) {
+    at += step_mm * Eigen::Vector3d(gaussian(random), gaussian(random), gaussian(random));
+    at = at.cwiseMax(Eigen::Vector3d(-2, -2, -2)).cwiseMin(Eigen::Vector3d(52, 27, 15));
+    path.push_back(at);
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST_GROUP(VirtualTool){};
+
+TEST(VirtualTool, NeverGougesTheTruePartOnRandomAndAdversarialPaths) {
+  std::mt19937_64 random(51);
+  for (const auto& facets : {tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5),
+                             tablegen::slotted_block(30.0, 12.0, 6.0, 2.0, 3.0, 10.0, 6.5),
+                             tablegen::thin_fin(20.0, 0.6, 8.0, 15.0, 12.2)}) {
+    const Loaded loaded(facets);
+    double worst = 0.0;
+    for (int walk = 0; walk < 12; ++walk) {
+      check_never_gouges(loaded.part, random_walk(random, 120, walk % 2 == 0 ? 0.05 : 0.8), worst);
+    }
+    // Plunges straight down through the part from above, and a device parked far inside it.
+    std::vector<Eigen::Vector3d> plunge;
+    for (double z = 12.0; z > -3.0; z -= 0.3) plunge.push_back({25.2, 12.4, z});
+    for (int i = 0; i < 20; ++i) plunge.push_back({25.0, 12.5, 1.0});
+    check_never_gouges(loaded.part, plunge, worst);
+    // Fast sweeps along x at heights through the part, each cycle a large jump.
+    std::vector<Eigen::Vector3d> sweep;
+    for (double z : {7.0, 4.0, 1.0}) {
+      for (double x = 2.0; x < 48.0; x += 3.0) sweep.push_back({x, 12.5, z});
+      for (double x = 48.0; x > 2.0; x -= 3.0) sweep.push_back({x, 12.9, z});
+    }
+    check_never_gouges(loaded.part, sweep, worst);
+  }
+}
+
+TEST(VirtualTool, AJumpStraightThroughTheThinFinInOneCycleIsStoppedAtTheFin) {
+  const Loaded loaded(tablegen::thin_fin(20.0, 0.6, 8.0, 15.0, 12.2));  // fin y in [12.2, 12.8]
+  VirtualTool tool(loaded.part, {25.0, 8.0, 2.0});
+  const RemediationResult result = tool.step({25.0, 17.0, 2.0}, ContactParameters{});
+  CHECK(result.status == RemediationStatus::Blocked || result.status == RemediationStatus::Stuck);
+  CHECK(tool.tip_mm().y() < 12.2 - 1.5 + 1e-3);  // still on the near side, the cutter short of the fin
+  double worst = 0.0;
+  check_never_gouges(loaded.part, {{25.0, 17.0, 2.0}, {25.0, 17.0, 2.0}, {25.0, 20.0, 2.0}}, worst);
+}
+
+TEST(VirtualTool, SlipsAlongAFaceInsteadOfStickingAtTheEntryPoint) {
+  const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
+  VirtualTool tool(loaded.part, {20.0, 12.5, 7.0});
+  const ContactParameters parameters{};
+  // Drag the device 0.2 mm into the top face from x = 20 to x = 30.
+  for (double x = 20.0; x <= 30.0; x += 0.05) {
+    static_cast<void>(tool.step({x, 12.5, 5.8}, parameters));
+  }
+  // The tool followed along the face (not stuck near x = 20), riding on it, not in it.
+  DOUBLES_EQUAL(30.0, tool.tip_mm().x(), 0.06);
+  CHECK(tool.tip_mm().z() >= 6.0 - loaded.part.header.gouge_bound_mm - 1e-5);
+  CHECK(tool.tip_mm().z() <= 6.0 + 0.01);
+}
+
+TEST(VirtualTool, NeverGoesBelowTheFloorOrOutOfTheWorkspace) {
+  const Loaded loaded(tablegen::thin_fin(20.0, 0.6, 8.0, 15.0, 12.2));
+  VirtualTool tool(loaded.part, {5.0, 5.0, 5.0});
+  for (const Eigen::Vector3d& desired : {Eigen::Vector3d(5, 5, -3), Eigen::Vector3d(-4, 5, 2), Eigen::Vector3d(60, 30, 40)}) {
+    for (int i = 0; i < 50; ++i) {
+      static_cast<void>(tool.step(desired, ContactParameters{}));
+    }
+    CHECK((tool.tip_mm().array() >= 0.0).all());
+    CHECK((tool.tip_mm().array() <= Eigen::Array3d(50.0, 25.0, 25.0)).all());
+  }
+  DOUBLES_EQUAL(50.0, tool.tip_mm().x(), 1e-9);
+}
+
+TEST(VirtualTool, TheSameInputsGiveBitIdenticalOutputs) {
+  const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
+  std::mt19937_64 random(52);
+  const auto path = random_walk(random, 200, 0.3);
+  VirtualTool a(loaded.part, kHome);
+  VirtualTool b(loaded.part, kHome);
+  for (const Eigen::Vector3d& desired : path) {
+    const RemediationResult ra = a.step(desired, ContactParameters{});
+    const RemediationResult rb = b.step(desired, ContactParameters{});
+    CHECK(ra.tip_mm == rb.tip_mm);
+    CHECK(ra.status == rb.status);
+  }
+}
+
+TEST(VirtualTool, ANonFiniteDesiredPoseIsAFaultAndTheToolStays) {
+  const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
+  VirtualTool tool(loaded.part, kHome);
+  const RemediationResult result = tool.step({std::numeric_limits<double>::quiet_NaN(), 1.0, 1.0}, ContactParameters{});
+  CHECK(result.status == RemediationStatus::Fault);
+  CHECK(tool.tip_mm() == kHome);
+}
+
+TEST_GROUP(HapticOutput){};
+
+TEST(HapticOutput, CouplingPullsTowardsTheVirtualToolAndIsClampedAtFiveNewtons) {
+  const ContactResult none{QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  const HapticLimits limits{};
+  const HapticOutput small = haptic_output({0, 0, 0}, {0.1, 0, 0}, none, limits);
+  CHECK((small.force_n - Eigen::Vector3d(0.5, 0, 0)).norm() < 1e-12);  // 0.5 N/mm x 1 device mm
+  CHECK_FALSE(small.clamped);
+  const HapticOutput large = haptic_output({0, 0, 0}, {0, 3.0, 0}, none, limits);
+  DOUBLES_EQUAL(5.0, large.force_n.norm(), 1e-12);
+  CHECK(large.clamped);
+  CHECK(large.force_n.normalized().dot(Eigen::Vector3d::UnitY()) > 0.999999);
+}
+
+TEST(HapticOutput, ANonFiniteInputGivesZeroAndAFault) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  ContactResult contact{QueryStatus::Ok, 1, 0.1, 0, Eigen::Vector3d(0, 0, nan), Eigen::Vector3d::Zero()};
+  const HapticOutput out = haptic_output({0, 0, 0}, {0, 0, 0}, contact, HapticLimits{});
+  CHECK(out.fault);
+  CHECK(out.force_n == Eigen::Vector3d::Zero());
+  CHECK(haptic_output({nan, 0, 0}, {0, 0, 0}, ContactResult{}, HapticLimits{}).fault);
+}
