@@ -1,0 +1,76 @@
+// Runs the cycle's engine calls (query, legality, touched marking, remediation, haptic output) with
+// every heap entry point wrapped at link time, and fails if any of them is reached while armed.
+// A plain program rather than a CppUTest suite: CppUTest's own operator new would clash.
+#include <cstdio>
+#include <cstdlib>
+#include <new>
+#include <random>
+
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/stencil/haptic_force.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/support/sample_tables.hpp"
+
+namespace {
+bool armed = false;
+unsigned long trapped = 0;
+void note(const char* what) {
+  if (armed) {
+    ++trapped;
+    armed = false;  // report once, without recursing through stdio's own allocations
+    std::fprintf(stderr, "allocation_trap: %s called inside the cycle\n", what);
+    armed = true;
+  }
+}
+}  // namespace
+
+extern "C" {
+void* __real_malloc(std::size_t);
+void* __real_calloc(std::size_t, std::size_t);
+void* __real_realloc(void*, std::size_t);
+void __real_free(void*);
+void* __wrap_malloc(std::size_t size) { note("malloc"); return __real_malloc(size); }
+void* __wrap_calloc(std::size_t count, std::size_t size) { note("calloc"); return __real_calloc(count, size); }
+void* __wrap_realloc(void* pointer, std::size_t size) { note("realloc"); return __real_realloc(pointer, size); }
+void __wrap_free(void* pointer) { note("free"); __real_free(pointer); }
+void* __real__Znwm(std::size_t);
+void* __real__Znam(std::size_t);
+void* __wrap__Znwm(std::size_t size) { note("operator new"); return __real__Znwm(size); }
+void* __wrap__Znam(std::size_t size) { note("operator new[]"); return __real__Znam(size); }
+}
+
+int main() {
+  using namespace stencil;
+  const tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(1));
+  static tables::PartTables part{};
+  if (!tables::load_tables({bytes.data(), bytes.size()}, part).ok) {
+    std::fprintf(stderr, "allocation_trap: the sample table did not load\n");
+    return 1;
+  }
+  static geometry::ToolBsp contact_tool{};
+  static engine::TriangleSet touched;
+  if (!engine::build_contact_tool(part.tool.spec, 0.01, contact_tool)) {
+    return 1;
+  }
+  engine::VirtualTool tool(part, {25.0, 12.5, 20.0});
+  const engine::ContactParameters parameters{};
+  const engine::HapticLimits limits{};
+  std::mt19937_64 random(61);
+  std::uniform_real_distribution<double> x(5.0, 45.0), y(2.0, 23.0), z(-1.0, 10.0);
+  unsigned long cycles = 0;
+  armed = true;
+  for (int i = 0; i < 5000; ++i) {
+    const Eigen::Vector3d desired(x(random), y(random), z(random));
+    const engine::ContactResult contact = engine::query_contacts(part, {desired, Eigen::Vector3d::UnitZ()}, parameters);
+    const engine::RemediationResult result = tool.step(desired, parameters);
+    static_cast<void>(engine::mark_touched(part, contact_tool, tool.pose(), 0.01, touched));
+    static_cast<void>(engine::haptic_output(desired, result.tip_mm, contact, limits));
+    ++cycles;
+  }
+  armed = false;
+  std::printf("allocation_trap: %lu cycles, %lu heap calls inside them, %zu triangles touched\n", cycles, trapped,
+              touched.count());
+  std::printf("%lu passed, %lu failed\n", trapped == 0 ? 1ul : 0ul, trapped == 0 ? 0ul : 1ul);
+  return trapped == 0 ? 0 : 1;
+}
