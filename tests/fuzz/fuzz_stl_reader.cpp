@@ -21,6 +21,7 @@ void require(bool promise) {
 // What parse_stl promises for every mesh it returns.
 void check_mesh(const stencil::tablegen::StlMesh& mesh) {
   require(mesh.solid_count >= 1);
+  require(!mesh.triangles.empty());  // a file with no facets is refused, binary or ASCII
   for (const stencil::tablegen::StlTriangle& triangle : mesh.triangles) {
     for (const Eigen::Vector3d& vertex : triangle.vertices) {
       require(vertex.allFinite());
