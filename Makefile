@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt fuzz clean help
+.PHONY: all deps build test test-asan test-debug rt fuzz bench clean help
 
 all: build
 
@@ -8,6 +8,7 @@ help:
 	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
 	@echo "make test-debug the same without optimisation (build/debug)"
 	@echo "make build      build only (binaries in build/bin)"
+	@echo "make bench      time the engine (query, full cycle) beside brute force and FCL: build/bin/stencil-bench"
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
@@ -21,6 +22,9 @@ build: deps
 
 test: build
 	ctest --preset release
+
+bench: build
+	build/bin/stencil-bench
 
 test-asan: deps
 	cmake --preset asan

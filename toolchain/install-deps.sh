@@ -30,6 +30,7 @@ packages=(
   nettle-dev         # SHA-256 of the source STL in the table header
   libcli11-dev       # the table generator's command line
   nlohmann-json3-dev # --inspect --json
+  libfcl-dev         # stencil-bench compares the engine with the Flexible Collision Library
   clang              # the fuzz preset's compiler (libFuzzer needs clang)
   libclang-rt-14-dev # libFuzzer and the sanitizer runtimes for clang 14 (only recommended by clang)
 )

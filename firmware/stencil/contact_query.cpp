@@ -9,6 +9,7 @@
 #include "firmware/geometry/kdop14.hpp"
 #include "firmware/geometry/tool_bound.hpp"
 #include "firmware/geometry/tool_bsp_builder.hpp"
+#include "firmware/geometry/upright_tool.hpp"
 
 namespace stencil::engine {
 namespace {
@@ -28,12 +29,16 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
   return true;
 }
 
-// Calls visit(point index, classification) for every point in a leaf whose DOP meets the tool's,
-// until visit returns false. Iterative, with a fixed stack as deep as the loader allows trees to be.
+// Calls visit(point index, classification) for every point that is in the tool or on its surface
+// (points outside are skipped), until visit returns false. Leaves are culled by the tool's 14-DOP
+// and, for the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a
+// ball's end); points by the outline before the BSP. Iterative, with a fixed stack as deep as the
+// loader allows trees to be.
 template <typename Visit>
-Walk walk_points_near_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
-                           Visit&& visit) {
+Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
+                         Visit&& visit) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
+  const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
   std::size_t size = 0;
   stack[size++] = 0;
@@ -46,15 +51,22 @@ Walk walk_points_near_tool(const tables::PartTables& part, const geometry::ToolB
     if (!overlaps_node(volume, node)) {
       continue;
     }
+    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, {node.dop_min[0], node.dop_min[1], node.dop_min[2]},
+                                                    {node.dop_max[0], node.dop_max[1], node.dop_max[2]}, 0.0)) {
+      continue;
+    }
     if (node.point_count > 0) {
       for (std::uint32_t i = node.first_point; i < node.first_point + node.point_count; ++i) {
         const tables::PackedPoint& p = part.points[i];
-        const geometry::PointClassification result =
-            geometry::classify_at_pose(tool, pose.tip_mm, pose.axis, Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm));
+        const Eigen::Vector3d point(p.x_mm, p.y_mm, p.z_mm);
+        if (upright && !geometry::upright_point_may_be_inside(tool, point - pose.tip_mm, 0.0)) {
+          continue;
+        }
+        const geometry::PointClassification result = geometry::classify_at_pose(tool, pose.tip_mm, pose.axis, point);
         if (result.contact == geometry::PointContact::BadTree) {
           return Walk::BadTree;
         }
-        if (!visit(i, result)) {
+        if (result.contact != geometry::PointContact::Outside && !visit(i, result)) {
           return Walk::Stopped;
         }
       }
@@ -86,7 +98,7 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   const Eigen::Vector3d centre = pose.tip_mm + parameters.compliance_centre_mm * pose.axis;
   Eigen::Vector3d force_sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_sum = Eigen::Vector3d::Zero();
-  const Walk walk = walk_points_near_tool(part, part.tool, pose, [&](std::uint32_t i, const geometry::PointClassification& c) {
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, [&](std::uint32_t i, const geometry::PointClassification& c) {
     if (c.contact != geometry::PointContact::Penetrating) {
       return true;
     }
@@ -125,7 +137,7 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
   if (!pose_is_usable(pose)) {
     return Legality::Fault;
   }
-  const Walk walk = walk_points_near_tool(part, part.tool, pose, [](std::uint32_t, const geometry::PointClassification& c) {
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, [](std::uint32_t, const geometry::PointClassification& c) {
     return c.contact != geometry::PointContact::Penetrating;
   });
   switch (walk) {
@@ -146,10 +158,9 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
   }
   const std::size_t before = touched.count();
   const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
-  static_cast<void>(walk_points_near_tool(part, contact_tool, inflated, [&](std::uint32_t i, const geometry::PointClassification& c) {
-    if (c.contact != geometry::PointContact::Outside) {
-      touched.insert(part.triangle_ids[i]);
-    }
+  static_cast<void>(walk_points_in_tool(part, contact_tool, inflated, [&](std::uint32_t i, const geometry::PointClassification& c) {
+    static_cast<void>(c);
+    touched.insert(part.triangle_ids[i]);
     return true;
   }));
   return static_cast<std::uint32_t>(touched.count() - before);

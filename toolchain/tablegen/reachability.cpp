@@ -9,32 +9,13 @@
 #include <thread>
 
 #include "firmware/geometry/kdop14.hpp"
+#include "firmware/geometry/upright_tool.hpp"
 
 namespace stencil::tablegen {
 namespace {
 
-// Radius of the tool's widest cross-section at or below height z above the tip (the tool widens
-// upwards, since the holder is at least as wide as the cutter).
-double radius_up_to(const geometry::ToolSpec& tool, double z) {
-  const double radius = tool.diameter_mm / 2.0;
-  if (z > tool.flute_length_mm) {
-    return tool.holder_diameter_mm / 2.0;
-  }
-  switch (tool.kind) {
-    case geometry::CutterKind::Flat:
-      return radius;
-    case geometry::CutterKind::Ball:
-      return z >= radius ? radius : std::sqrt(std::max(0.0, radius * radius - (radius - z) * (radius - z)));
-    case geometry::CutterKind::BullNose: {
-      const double corner = tool.corner_radius_mm;
-      return z >= corner ? radius
-                         : (radius - corner) + std::sqrt(std::max(0.0, corner * corner - (corner - z) * (corner - z)));
-    }
-  }
-  return radius;
-}
-
-// The 14-DOP of a ball end mill's sphere at this tip (empty for other cutters).
+// The 14-DOP of a ball end mill's sphere at this tip (empty for other cutters): its diagonal slabs
+// hug sloping surfaces better than the box test alone.
 geometry::Kdop14 ball_dop(const geometry::ToolSpec& tool, const Eigen::Vector3d& tip) {
   geometry::Kdop14 dop = geometry::Kdop14::empty();
   if (tool.kind == geometry::CutterKind::Ball) {
@@ -45,64 +26,18 @@ geometry::Kdop14 ball_dop(const geometry::ToolSpec& tool, const Eigen::Vector3d&
   return dop;
 }
 
-// Whether the node's box can hold a point inside the upright tool at `tip`.
-bool box_may_touch(const geometry::ToolSpec& tool, double total_length, const tables::BvhNode& node,
-                   const Eigen::Vector3d& tip, const geometry::Kdop14& ball) {
-  const double z_low = node.dop_min[2] - tip.z();
-  const double z_high = node.dop_max[2] - tip.z();
-  if (z_high < kReachTolerance_mm || z_low > total_length) {
-    return false;  // entirely below the tip (within tolerance) or above the holder
-  }
-  const double dx = std::max({node.dop_min[0] - tip.x(), tip.x() - node.dop_max[0], 0.0});
-  const double dy = std::max({node.dop_min[1] - tip.y(), tip.y() - node.dop_max[1], 0.0});
-  const double reach = radius_up_to(tool, std::min(z_high, total_length));
-  if (dx * dx + dy * dy >= reach * reach) {
-    return false;
-  }
-  // A box wholly below a ball's centre can only meet the ball: test the sphere itself.
-  const double radius = tool.diameter_mm / 2.0;
-  if (tool.kind == geometry::CutterKind::Ball && z_high < radius) {
-    // Both the sphere's own 14-DOP (its slabs hug sloping surfaces) and the box-sphere distance.
+bool node_may_touch(const geometry::ToolBsp& tool, const tables::BvhNode& node, const Eigen::Vector3d& tip,
+                    const geometry::Kdop14& ball) {
+  if (tool.spec.kind == geometry::CutterKind::Ball && node.dop_max[2] - tip.z() < tool.envelope.cutter_radius_mm) {
     geometry::Kdop14 volume;
     std::copy(std::begin(node.dop_min), std::end(node.dop_min), volume.min.begin());
     std::copy(std::begin(node.dop_max), std::end(node.dop_max), volume.max.begin());
     if (!geometry::overlaps(volume, ball)) {
       return false;
     }
-    const double dz = radius - z_high;  // the box's top is the nearest height to the centre
-    return dx * dx + dy * dy + dz * dz < radius * radius;
   }
-  return true;
-}
-
-// Whether a point (relative to the tip) may be inside the tool: the exact outline, tested with
-// squares only, so that the BSP is asked about the few points that matter.
-bool may_be_inside(const geometry::ToolSpec& tool, const geometry::ToolEnvelope& envelope, const Eigen::Vector3d& local) {
-  const double z = local.z();
-  if (z < kReachTolerance_mm || z > envelope.total_length_mm) {
-    return false;
-  }
-  const double r_squared = local.x() * local.x() + local.y() * local.y();
-  if (z > envelope.flute_length_mm) {
-    return r_squared < envelope.holder_radius_mm * envelope.holder_radius_mm;
-  }
-  const double radius = envelope.cutter_radius_mm;
-  if (r_squared >= radius * radius) {
-    return false;
-  }
-  if (tool.kind == geometry::CutterKind::Ball && z < radius) {
-    return r_squared + (z - radius) * (z - radius) < radius * radius;
-  }
-  if (tool.kind == geometry::CutterKind::BullNose && z < tool.corner_radius_mm) {
-    const double flat = radius - tool.corner_radius_mm;
-    if (r_squared <= flat * flat) {
-      return true;
-    }
-    const double r = std::sqrt(r_squared);
-    return (r - flat) * (r - flat) + (z - tool.corner_radius_mm) * (z - tool.corner_radius_mm) <
-           tool.corner_radius_mm * tool.corner_radius_mm;
-  }
-  return true;
+  return geometry::upright_box_may_touch(tool, tip, {node.dop_min[0], node.dop_min[1], node.dop_min[2]},
+                                         {node.dop_max[0], node.dop_max[1], node.dop_max[2]}, kReachTolerance_mm);
 }
 
 }  // namespace
@@ -143,22 +78,20 @@ bool touching_tip(const geometry::ToolSpec& tool, const Eigen::Vector3d& point, 
 }
 
 bool upright_tool_collides(const ReachInput& input, const Eigen::Vector3d& tip) {
-  const geometry::ToolSpec& spec = input.tool.spec;
-  const double total_length = input.tool.envelope.total_length_mm;
-  const geometry::Kdop14 ball = ball_dop(spec, tip);
+  const geometry::Kdop14 ball = ball_dop(input.tool.spec, tip);
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack{};
   std::size_t size = 0;
   stack[size++] = 0;
   while (size > 0) {
     const tables::BvhNode& node = input.nodes[stack[--size]];
-    if (!box_may_touch(spec, total_length, node, tip, ball)) {
+    if (!node_may_touch(input.tool, node, tip, ball)) {
       continue;
     }
     if (node.point_count > 0) {
       for (std::uint32_t i = node.first_point; i < node.first_point + node.point_count; ++i) {
         const tables::PackedPoint& p = input.points[i];
         const Eigen::Vector3d local = Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - tip;
-        if (!may_be_inside(spec, input.tool.envelope, local)) {
+        if (!geometry::upright_point_may_be_inside(input.tool, local, kReachTolerance_mm)) {
           continue;
         }
         const geometry::PointClassification result = geometry::classify_in_tool_frame(input.tool, local);

@@ -1,0 +1,190 @@
+// stencil-bench: time of the collision query and of the full cycle (query + remediation with its
+// sweep) on finely tessellated parts of 1e4, 1e5 and 1e6 points, in free space, in light and deep
+// contact, beside brute force (every point through the tool BSP) and FCL on the same data.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/bench/fcl_reference.hpp"
+#include "toolchain/tablegen/sample_parts.hpp"
+#include "toolchain/tablegen/table_generator.hpp"
+#include "toolchain/tablegen/tool_option.hpp"
+
+namespace {
+
+using namespace stencil;
+using Clock = std::chrono::steady_clock;
+
+// The bench part: a finely tessellated open height field over [5, 45] x [2.5, 22.5] mm, a flat
+// lower level at z = 3 for x < 25 and an upper level at z = 6 beyond, so it has flat faces and a
+// concave corner where the lower level meets the step.
+constexpr double kLow = 3.0, kHigh = 6.0, kStepX = 25.0;
+
+std::vector<tablegen::Facet> stepped_field(std::size_t triangles) {
+  const double width = 40.0, depth = 20.0, x0 = 5.0, y0 = 2.5;
+  const double cells = static_cast<double>(triangles) / 2.0;
+  const auto n = static_cast<std::size_t>(std::max(2.0, std::round(std::sqrt(cells * width / depth))));
+  const auto m = static_cast<std::size_t>(std::max(2.0, std::round(cells / static_cast<double>(n))));
+  const auto at = [&](std::size_t i, std::size_t j) {
+    const double x = x0 + width * static_cast<double>(i) / static_cast<double>(n);
+    return Eigen::Vector3d(x, y0 + depth * static_cast<double>(j) / static_cast<double>(m), x < kStepX ? kLow : kHigh);
+  };
+  std::vector<tablegen::Facet> facets;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t j = 0; j < m; ++j) {
+      facets.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      facets.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  return facets;
+}
+
+struct Timing {
+  double median_us;
+  double p999_us;
+  double max_us;
+  std::size_t samples;
+};
+
+template <typename Work>
+Timing measure(Work&& work, std::size_t iterations, double budget_s) {
+  std::vector<double> samples;
+  samples.reserve(iterations);
+  const auto started = Clock::now();
+  for (std::size_t i = 0; i < iterations; ++i) {
+    const auto begin = Clock::now();
+    work();
+    const auto end = Clock::now();
+    samples.push_back(std::chrono::duration<double, std::micro>(end - begin).count());
+    if (i >= 10 && std::chrono::duration<double>(end - started).count() > budget_s) {
+      break;
+    }
+  }
+  std::sort(samples.begin(), samples.end());
+  const std::size_t n = samples.size();
+  const std::size_t p999 = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.999 * static_cast<double>(n))) - 1);
+  return {samples[n / 2], samples[p999], samples.back(), n};
+}
+
+struct State {
+  const char* name;
+  Eigen::Vector3d desired;  // the device's tip
+  Eigen::Vector3d resting;  // a legal tip next to it, where the virtual tool starts the cycle
+};
+
+// Brute force: every point of the table through the tool BSP.
+std::size_t brute_force(const tables::PartTables& part, const Eigen::Vector3d& tip) {
+  std::size_t penetrating = 0;
+  for (std::uint32_t i = 0; i < part.point_count(); ++i) {
+    const auto& p = part.points[i];
+    const auto c = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), {p.x_mm, p.y_mm, p.z_mm});
+    penetrating += c.contact == geometry::PointContact::Penetrating ? 1 : 0;
+  }
+  return penetrating;
+}
+
+volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  bool json = false;
+  std::vector<std::size_t> sizes = {10'000, 100'000, 1'000'000};
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    if (argument == "--json") {
+      json = true;
+    } else if (argument == "--quick") {
+      sizes = {10'000, 100'000};
+    } else {
+      std::printf(
+          "usage: stencil-bench [--json] [--quick]\n"
+          "Times the collision query and the full cycle (query + remediation with sweep) on parts of\n"
+          "1e4, 1e5 and 1e6 points (--quick: the first two) in free space, light contact (0.05 mm into a\n"
+          "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
+          "FCL. --json: one JSON object per line.\n");
+      return argument == "--help" || argument == "-h" ? 0 : 2;
+    }
+  }
+  if (!json) {
+    std::printf("%9s %-12s %-10s %-5s %10s %10s %10s %8s\n", "points", "state", "impl", "what", "median_us",
+                "p999_us", "max_us", "samples");
+  }
+  const double radius = 1.5;
+  const std::vector<State> states = {
+      {"free", {15.0, 12.5, 9.0}, {15.0, 12.5, 9.0}},
+      {"light", {15.0, 12.5, kLow - 0.05}, {15.0, 12.5, kLow + 0.001}},
+      {"deep", {15.0, 12.5, kLow - 0.5}, {15.0, 12.5, kLow + 0.001}},
+      {"deep-corner", {kStepX - radius + 0.5, 12.5, kLow - 0.5}, {kStepX - radius - 0.3, 12.5, kLow + 0.001}},
+  };
+  for (const std::size_t target : sizes) {
+    // About a third as many triangles as points; the rest of the points seeded on the surface.
+    const std::vector<tablegen::Facet> facets = stepped_field(target / 3);
+    tablegen::GeneratorOptions options;
+    options.tool = tablegen::parse_tool("ball:d=3", "");
+    options.spacing_mm = 50.0;  // fine triangles: vertices and centroids, no subdivision
+    options.force = true;
+    options.extra_points = target - std::min<std::size_t>(target, facets.size() * 3 / 2);
+    options.threads = 2;
+    tablegen::GeneratorReport report;
+    tablegen::TableContents contents = tablegen::generate_tables(tablegen::encode_stl(facets, true, "bench"),
+                                                                 "bench.stl", options, report, [](const char*, double) {});
+    const tablegen::TableBytes bytes = tablegen::assemble_table(contents);
+    tables::PartTables part{};
+    const tables::TableLoadResult loaded = tables::load_tables({bytes.data(), bytes.size()}, part);
+    if (!loaded.ok) {
+      std::fprintf(stderr, "stencil-bench: the bench table did not load: %s\n", loaded.field);
+      return 1;
+    }
+    std::vector<float> triangles(9 * part.triangle_count());
+    std::memcpy(triangles.data(), part.triangles, triangles.size() * sizeof(float));
+    const bench::FclReference fcl(triangles.data(), part.triangle_count());
+    const engine::ContactParameters parameters{};
+
+    const auto report_row = [&](const State& state, const char* impl, const char* what, const Timing& t) {
+      if (json) {
+        std::printf(
+            "{\"points\": %u, \"triangles\": %u, \"state\": \"%s\", \"impl\": \"%s\", \"what\": \"%s\", "
+            "\"median_us\": %.3f, \"p999_us\": %.3f, \"max_us\": %.3f, \"samples\": %zu}\n",
+            part.point_count(), part.triangle_count(), state.name, impl, what, t.median_us, t.p999_us, t.max_us,
+            t.samples);
+      } else {
+        std::printf("%9u %-12s %-10s %-5s %10.2f %10.2f %10.2f %8zu\n", part.point_count(), state.name, impl, what,
+                    t.median_us, t.p999_us, t.max_us, t.samples);
+      }
+      std::fflush(stdout);
+    };
+
+    for (const State& state : states) {
+      const engine::ToolPose pose{state.desired, Eigen::Vector3d::UnitZ()};
+      const Timing query = measure([&] { sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm; },
+                                   5000, 2.0);
+      report_row(state, "stencil", "query", query);
+      const Timing cycle = measure(
+          [&] {
+            engine::VirtualTool tool(part, state.resting);
+            const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
+            const engine::RemediationResult result = tool.step(state.desired, parameters);
+            sink = sink + contact.max_depth_mm + result.tip_mm.z();
+          },
+          5000, 2.0);
+      report_row(state, "stencil", "cycle", cycle);
+      const Timing brute = measure([&] { sink = sink + static_cast<double>(brute_force(part, state.desired)); },
+                                   200, 2.0);
+      report_row(state, "bruteforce", "query", brute);
+      const double tip[3] = {state.desired.x(), state.desired.y(), state.desired.z()};
+      const Timing reference = measure(
+          [&] { sink = sink + fcl.query(tip, true, radius, part.tool.envelope.flute_length_mm).max_depth_mm; }, 500,
+          2.0);
+      report_row(state, "fcl", "query", reference);
+    }
+  }
+  return 0;
+}
