@@ -58,7 +58,8 @@ VirtualTool::Sweep VirtualTool::sweep(const Eigen::Vector3d& to, Eigen::Vector3d
   return needed > kMaxSweepSteps ? Sweep::Limited : Sweep::Legal;
 }
 
-RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactParameters& parameters) {
+RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
+                                    const ContactParameters& parameters) {
   RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0};
   if (!desired_tip_mm.allFinite()) {
     result.status = RemediationStatus::Fault;
@@ -69,7 +70,10 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
   const bool clamped = candidate != desired_tip_mm;
   bool found = false;
   for (int iteration = 0; iteration <= kMaxSlipIterations; ++iteration) {
-    const ContactResult contact = query_contacts(part_, {candidate, Eigen::Vector3d::UnitZ()}, parameters);
+    // The first candidate is the desired pose itself unless a wall of the box moved it.
+    const ContactResult contact = (iteration == 0 && !clamped)
+                                      ? contact_at_desired
+                                      : query_contacts(part_, {candidate, Eigen::Vector3d::UnitZ()}, parameters);
     if (contact.status != QueryStatus::Ok) {
       result.status = RemediationStatus::Fault;
       return result;

@@ -40,8 +40,14 @@ class VirtualTool {
   VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm);
 
   // One cycle: moves towards `desired_tip_mm` as far as legality allows. Allocation-free, bounded
-  // by kMaxSlipIterations queries and kMaxSweepSteps legality checks per sweep.
-  RemediationResult step(const Eigen::Vector3d& desired_tip_mm, const ContactParameters& parameters);
+  // by kMaxSlipIterations queries and kMaxSweepSteps legality checks per sweep. The cycle already
+  // queries the desired pose for the haptic force: pass that result in, so it is not done twice.
+  RemediationResult step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
+                         const ContactParameters& parameters);
+  RemediationResult step(const Eigen::Vector3d& desired_tip_mm, const ContactParameters& parameters) {
+    return step(desired_tip_mm, query_contacts(part_, {desired_tip_mm, Eigen::Vector3d::UnitZ()}, parameters),
+                parameters);
+  }
 
   [[nodiscard]] const Eigen::Vector3d& tip_mm() const { return tip_; }
   [[nodiscard]] ToolPose pose() const { return {tip_, Eigen::Vector3d::UnitZ()}; }

@@ -171,7 +171,7 @@ int main(int argc, char** argv) {
           [&] {
             engine::VirtualTool tool(part, state.resting);
             const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
-            const engine::RemediationResult result = tool.step(state.desired, parameters);
+            const engine::RemediationResult result = tool.step(state.desired, contact, parameters);
             sink = sink + contact.max_depth_mm + result.tip_mm.z();
           },
           5000, 2.0);

@@ -63,7 +63,7 @@ int main() {
   for (int i = 0; i < 5000; ++i) {
     const Eigen::Vector3d desired(x(random), y(random), z(random));
     const engine::ContactResult contact = engine::query_contacts(part, {desired, Eigen::Vector3d::UnitZ()}, parameters);
-    const engine::RemediationResult result = tool.step(desired, parameters);
+    const engine::RemediationResult result = tool.step(desired, contact, parameters);
     static_cast<void>(engine::mark_touched(part, contact_tool, tool.pose(), 0.01, touched));
     static_cast<void>(engine::haptic_output(desired, result.tip_mm, contact, limits));
     ++cycles;

@@ -8,6 +8,7 @@
 #include "firmware/stencil/contact_query.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
+#include "toolchain/tablegen/tool_option.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>
@@ -116,4 +117,35 @@ TEST(ContactQuery, TouchedTrianglesAreThoseNearTheToolOnly) {
   // Hovering 0.05 mm above: nothing.
   TriangleSet none;
   LONGS_EQUAL(0, mark_touched(part, contact_tool, upright_at(25.3, 12.1, kTop_mm + 0.05), 0.01, none));
+}
+
+TEST_GROUP(ContactForceContinuity){};
+
+TEST(ContactForceContinuity, ForceChangesSmoothlyAsContactCrossesTheToolsRegions) {
+  // A bull-nose end mill (flat bottom, corner torus, side) 0.1 mm into the top of the prism, moved
+  // off its edge in fine steps: contact passes from the bottom to the corner to the side of the tool.
+  tablegen::GeneratorOptions options = test::default_job_options(2);
+  options.tool = tablegen::parse_tool("bull:d=6,r=1", "");
+  const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+  tables::PartTables part{};
+  CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+  const ContactParameters parameters{};
+  const double step = 0.002;  // mm
+  Eigen::Vector3d previous_force = Eigen::Vector3d::Zero();
+  double largest_jump = 0.0;
+  int in_contact = 0;
+  // Along -x from over the face to past the corner at x = 17 (the prism's -x corner), y through the centre.
+  for (double x = 22.0; x > 13.0; x -= step) {
+    const ContactResult result = query_contacts(part, {{x, 12.5, 6.0 - 0.1}, Eigen::Vector3d::UnitZ()}, parameters);
+    if (result.penetrating_points > 0) {
+      ++in_contact;
+    }
+    if (x < 22.0) {
+      largest_jump = std::max(largest_jump, (result.force_n - previous_force).norm());
+    }
+    previous_force = result.force_n;
+  }
+  CHECK(in_contact > 1000);
+  // k_world = 10 N/mm: a 2 um step may change the force by a fraction of 10 * 0.1 = 1 N, never jump by it.
+  CHECK_TEXT(largest_jump < 0.1, "the contact force jumped");
 }
