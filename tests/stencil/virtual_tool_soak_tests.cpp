@@ -9,7 +9,7 @@
 #include "firmware/stencil/virtual_tool.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
-#include "tests/support/triangle_distance.hpp"
+#include "tests/support/gouge_oracle.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -20,18 +20,6 @@ using namespace stencil::engine;
 
 namespace {
 
-double true_gouge_mm(const tables::PartTables& part, const Eigen::Vector3d& tip) {
-  const double radius = part.tool.envelope.cutter_radius_mm;
-  const Eigen::Vector3d low = tip + Eigen::Vector3d(0, 0, radius);
-  const Eigen::Vector3d high = tip + Eigen::Vector3d(0, 0, part.tool.envelope.flute_length_mm);
-  double deepest = 0.0;
-  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
-    const auto& v = part.triangles[t].vertices;
-    const auto vertex = [&](int i) { return Eigen::Vector3d(v[i].x_mm, v[i].y_mm, v[i].z_mm); };
-    deepest = std::max(deepest, radius - test::segment_triangle_distance(low, high, vertex(0), vertex(1), vertex(2)));
-  }
-  return deepest;
-}
 
 // Kinds of trajectory, each a short burst of device samples.
 std::vector<Eigen::Vector3d> trajectory(std::mt19937_64& random, int kind, const Eigen::Vector3d& target) {
@@ -79,7 +67,7 @@ void soak(const std::vector<tablegen::Facet>& facets, const Eigen::Vector3d& cor
       if (result.status == RemediationStatus::Fault || check_legal(part, tool.pose()) != Legality::Legal) {
         FAIL("the virtual tool faulted or ended illegal");
       }
-      worst = std::max(worst, true_gouge_mm(part, tool.tip_mm()));
+      worst = std::max(worst, test::ball_end_gouge_mm(part, tool.tip_mm()));
     }
   }
   CHECK(cycles > 20000);

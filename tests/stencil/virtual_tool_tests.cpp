@@ -11,7 +11,7 @@
 #include "firmware/stencil/virtual_tool.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
-#include "tests/support/triangle_distance.hpp"
+#include "tests/support/gouge_oracle.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -24,21 +24,6 @@ namespace {
 
 const Eigen::Vector3d kHome(25.0, 12.5, 20.0);  // above every sample part
 
-// How deep the ball end mill at `tip` cuts into the true triangles (0 when it does not): the
-// cutter is a capsule of radius R around the axis from tip + R to the top of the flutes.
-double true_gouge_mm(const tables::PartTables& part, const Eigen::Vector3d& tip) {
-  const double radius = part.tool.envelope.cutter_radius_mm;
-  const Eigen::Vector3d low = tip + Eigen::Vector3d(0, 0, radius);
-  const Eigen::Vector3d high = tip + Eigen::Vector3d(0, 0, part.tool.envelope.flute_length_mm);
-  double deepest = 0.0;
-  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
-    const auto& v = part.triangles[t].vertices;
-    const auto vertex = [&](int i) { return Eigen::Vector3d(v[i].x_mm, v[i].y_mm, v[i].z_mm); };
-    const double distance = test::segment_triangle_distance(low, high, vertex(0), vertex(1), vertex(2));
-    deepest = std::max(deepest, radius - distance);
-  }
-  return deepest;
-}
 
 struct Loaded {
   tablegen::TableBytes bytes;
@@ -58,7 +43,7 @@ void check_never_gouges(const tables::PartTables& part, const std::vector<Eigen:
     CHECK(result.status != RemediationStatus::Fault);
     CHECK(check_legal(part, tool.pose()) == Legality::Legal);
     CHECK(tool.tip_mm().z() >= 0.0);
-    const double gouge = true_gouge_mm(part, tool.tip_mm());
+    const double gouge = test::ball_end_gouge_mm(part, tool.tip_mm());
     worst = std::max(worst, gouge);
     CHECK(gouge <= part.header.gouge_bound_mm + 1e-5);
   }
