@@ -1,15 +1,18 @@
 // The query: the tool's 14-DOP against the points' tree, then each nearby point through the tool BSP.
 #include "firmware/stencil/contact_query.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
 #include <Eigen/Geometry>
 
 #include "firmware/geometry/kdop14.hpp"
+#include "firmware/geometry/meridian_box.hpp"
 #include "firmware/geometry/tool_bound.hpp"
 #include "firmware/geometry/tool_bsp_builder.hpp"
 #include "firmware/geometry/upright_tool.hpp"
+#include "firmware/stencil/leaf_contacts.hpp"
 
 namespace stencil::engine {
 namespace {
@@ -29,19 +32,24 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
   return true;
 }
 
-// Calls visit(point index, classification) for every point that is in the tool or on its surface
-// (points outside are skipped), until visit returns false. Leaves are culled by the tool's 14-DOP
-// and, for the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a
-// ball's end); points by the outline before the BSP. Iterative, with a fixed stack as deep as the
-// loader allows trees to be.
-template <typename Visit>
+// Walks the points' tree for the tool at `pose`. Leaves are culled by the tool's 14-DOP and, for
+// the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
+// end). For the upright tool each remaining leaf goes to visit_leaf as a whole, its points' depths
+// and escape directions computed lane-wise: from one region's surface when the leaf's box lies in
+// that region (no walk of the tool tree per point), point by point through the tool tree when the
+// box straddles its tests, skipped when the box is wholly outside. For any other axis each point
+// goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
+// on its surface. Either visitor stops the walk by returning false. Iterative, with a fixed stack
+// as deep as the loader allows trees to be.
+template <typename VisitPoint, typename VisitLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
-                         Visit&& visit) {
+                         VisitPoint&& visit_point, VisitLeaf&& visit_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
   std::size_t size = 0;
   stack[size++] = 0;
+  LeafContacts leaf;
   while (size > 0) {
     const std::uint32_t index = stack[--size];
     if (index >= part.node_count()) {
@@ -51,22 +59,44 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     if (!overlaps_node(volume, node)) {
       continue;
     }
-    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, {node.dop_min[0], node.dop_min[1], node.dop_min[2]},
-                                                    {node.dop_max[0], node.dop_max[1], node.dop_max[2]}, 0.0)) {
+    const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
+    const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
+    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
     }
     if (node.point_count > 0) {
+      if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
+          node.point_count > part.point_count() - node.first_point) {
+        return Walk::BadTree;  // a leaf the loader would have refused
+      }
+      if (upright) {
+        const geometry::BoxClassification cover =
+            geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+        if (cover.cover == geometry::BoxCover::Outside) {
+          continue;
+        }
+        load_leaf(part, node.first_point, node.point_count, leaf);
+        const bool finite =
+            cover.cover == geometry::BoxCover::Mixed
+                ? mixed_leaf_contacts(tool, pose.tip_mm, leaf)
+                : region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
+                                       pose.tip_mm, leaf);
+        if (!finite) {
+          return Walk::BadTree;
+        }
+        if (!visit_leaf(leaf)) {
+          return Walk::Stopped;
+        }
+        continue;
+      }
       for (std::uint32_t i = node.first_point; i < node.first_point + node.point_count; ++i) {
         const tables::PackedPoint& p = part.points[i];
         const Eigen::Vector3d point(p.x_mm, p.y_mm, p.z_mm);
-        if (upright && !geometry::upright_point_may_be_inside(tool, point - pose.tip_mm, 0.0)) {
-          continue;
-        }
         const geometry::PointClassification result = geometry::classify_at_pose(tool, pose.tip_mm, pose.axis, point);
         if (result.contact == geometry::PointContact::BadTree) {
           return Walk::BadTree;
         }
-        if (result.contact != geometry::PointContact::Outside && !visit(i, result)) {
+        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result)) {
           return Walk::Stopped;
         }
       }
@@ -86,6 +116,9 @@ Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
   return {n.x_mm, n.y_mm, n.z_mm};
 }
 
+// Below this length the point's normal and the tool's escape direction cancel: no direction.
+constexpr double kNoDirection = 1e-12;
+
 }  // namespace
 
 ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pose, const ContactParameters& parameters) {
@@ -98,20 +131,23 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   const Eigen::Vector3d centre = pose.tip_mm + parameters.compliance_centre_mm * pose.axis;
   Eigen::Vector3d force_sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_sum = Eigen::Vector3d::Zero();
-  const Walk walk = walk_points_in_tool(part, part.tool, pose, [&](std::uint32_t i, const geometry::PointClassification& c) {
+  const auto count_depth = [&](std::uint32_t i, double depth) {
+    ++result.penetrating_points;
+    if (depth > result.max_depth_mm) {
+      result.max_depth_mm = depth;
+      result.deepest_point = i;
+    }
+  };
+  const auto visit_point = [&](std::uint32_t i, const geometry::PointClassification& c) {
     if (c.contact != geometry::PointContact::Penetrating) {
       return true;
     }
-    ++result.penetrating_points;
-    if (c.depth_mm > result.max_depth_mm) {
-      result.max_depth_mm = c.depth_mm;
-      result.deepest_point = i;
-    }
+    count_depth(i, c.depth_mm);
     // The part pushes the tool out along the point's normal; the tool's own escape direction says
     // the same from the other side. Their average is robust where one of them is poor.
     Eigen::Vector3d direction = normal_of(part, i) - c.escape_direction;
     const double length = direction.norm();
-    if (length < 1e-12) {
+    if (length < kNoDirection) {
       return true;  // the two disagree completely: this point gives no direction
     }
     direction /= length;
@@ -120,7 +156,22 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     force_sum += force;
     torque_sum += (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).cross(force);
     return true;
-  });
+  };
+  // The same per point as visit_point, the arithmetic lane-wise over the leaf, then the sums in
+  // point order (so the result does not depend on how it was computed).
+  LeafForces forces;
+  const auto visit_leaf = [&](const LeafContacts& leaf) {
+    leaf_forces(leaf, k_world, centre, forces);
+    for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+      if (leaf.depth[lane] > geometry::kSurfaceTolerance_mm) {
+        count_depth(leaf.first + lane, leaf.depth[lane]);
+        force_sum += Eigen::Vector3d(forces.fx[lane], forces.fy[lane], forces.fz[lane]);
+        torque_sum += Eigen::Vector3d(forces.tx[lane], forces.ty[lane], forces.tz[lane]);
+      }
+    }
+    return true;
+  };
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, visit_point, visit_leaf);
   if (walk == Walk::BadTree) {
     return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   }
@@ -137,9 +188,13 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
   if (!pose_is_usable(pose)) {
     return Legality::Fault;
   }
-  const Walk walk = walk_points_in_tool(part, part.tool, pose, [](std::uint32_t, const geometry::PointClassification& c) {
-    return c.contact != geometry::PointContact::Penetrating;
-  });
+  const Walk walk = walk_points_in_tool(
+      part, part.tool, pose,
+      [](std::uint32_t, const geometry::PointClassification& c) {
+        return c.contact != geometry::PointContact::Penetrating;
+      },
+      // Lanes past the leaf's count repeat its last point, so all lanes can be tested.
+      [](const LeafContacts& leaf) { return !(leaf.depth > geometry::kSurfaceTolerance_mm).any(); });
   switch (walk) {
     case Walk::Finished:
       return Legality::Legal;
@@ -158,11 +213,20 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
   }
   const std::size_t before = touched.count();
   const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
-  static_cast<void>(walk_points_in_tool(part, contact_tool, inflated, [&](std::uint32_t i, const geometry::PointClassification& c) {
-    static_cast<void>(c);
-    touched.insert(part.triangle_ids[i]);
-    return true;
-  }));
+  static_cast<void>(walk_points_in_tool(
+      part, contact_tool, inflated,
+      [&](std::uint32_t i, const geometry::PointClassification&) {
+        touched.insert(part.triangle_ids[i]);
+        return true;
+      },
+      [&](const LeafContacts& leaf) {
+        for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+          if (leaf.in_tool[lane]) {
+            touched.insert(part.triangle_ids[leaf.first + lane]);
+          }
+        }
+        return true;
+      }));
   return static_cast<std::uint32_t>(touched.count() - before);
 }
 

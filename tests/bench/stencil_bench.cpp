@@ -96,6 +96,7 @@ volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
 
 int main(int argc, char** argv) {
   bool json = false;
+  bool references = true;
   std::vector<std::size_t> sizes = {10'000, 100'000, 1'000'000};
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -103,13 +104,18 @@ int main(int argc, char** argv) {
       json = true;
     } else if (argument == "--quick") {
       sizes = {10'000, 100'000};
+    } else if (argument == "--large") {
+      sizes = {1'000'000};
+    } else if (argument == "--stencil-only") {
+      references = false;
     } else {
       std::printf(
-          "usage: stencil-bench [--json] [--quick]\n"
+          "usage: stencil-bench [--json] [--quick | --large] [--stencil-only]\n"
           "Times the collision query and the full cycle (query + remediation with sweep) on parts of\n"
           "1e4, 1e5 and 1e6 points (--quick: the first two) in free space, light contact (0.05 mm into a\n"
           "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
-          "FCL. --json: one JSON object per line.\n");
+          "FCL. --large: only 1e6 points. --stencil-only: leave out brute force and FCL (for profiling).\n"
+          "--json: one JSON object per line.\n");
       return argument == "--help" || argument == "-h" ? 0 : 2;
     }
   }
@@ -176,6 +182,9 @@ int main(int argc, char** argv) {
           },
           5000, 2.0);
       report_row(state, "stencil", "cycle", cycle);
+      if (!references) {
+        continue;
+      }
       const Timing brute = measure([&] { sink = sink + static_cast<double>(brute_force(part, state.desired)); },
                                    200, 2.0);
       report_row(state, "bruteforce", "query", brute);

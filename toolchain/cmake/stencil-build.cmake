@@ -16,10 +16,13 @@ if(STENCIL_SANITIZE)
   add_link_options(-fsanitize=address,undefined)
 endif()
 
-# The 1 kHz core: no exceptions, no RTTI, and any dynamic Eigen allocation aborts.
+# The 1 kHz core: no exceptions, no RTTI, and any dynamic Eigen allocation aborts. The core never
+# reads errno or the floating-point exception flags, so sqrt need not set the one and selects need
+# not preserve the other: then sqrt is one instruction and the per-point loops vectorise. Results
+# are unchanged (IEEE operations are exact-rounded either way).
 add_library(stencil_core_flags INTERFACE)
 target_compile_options(stencil_core_flags INTERFACE
-  $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti>)
+  $<$<COMPILE_LANGUAGE:CXX>:-fno-exceptions -fno-rtti -fno-math-errno -fno-trapping-math>)
 
 # stencil_core_library(NAME SOURCES...): a static library of the allocation-free core. It is
 # checked right after it is built (every preset, cross builds included, with that toolchain's nm)

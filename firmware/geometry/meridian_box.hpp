@@ -1,0 +1,46 @@
+// Which region of the tool's BSP a whole box of the meridian plane is in, decided once for the box
+// instead of once per point: the query uses it to settle a leaf of the part's tree in one walk.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/geometry/tool_bsp.hpp"
+
+namespace stencil::geometry {
+
+// A rectangle of the meridian half-plane (mm): r_low >= 0, low <= high.
+struct MeridianBox {
+  double r_low_mm;
+  double r_high_mm;
+  double z_low_mm;
+  double z_high_mm;
+};
+
+enum class BoxCover : std::uint8_t {
+  Outside,         // every point of the box is outside the tool
+  Region,          // every point of the box reaches region `region` (inside the tool or on its surface)
+  RegionOrOutside, // the box straddles the boundary surface of region `region` and nothing else:
+                   // a point reaches the region exactly when its interior distance to the region's
+                   // surface is at least -kSurfaceTolerance_mm, and is outside the tool otherwise
+  Mixed,           // the box straddles other tests of the tree (or the tree or box is unusable):
+                   // ask per point
+};
+
+struct BoxClassification {
+  BoxCover cover;
+  std::uint8_t region;  // valid for Region and RegionOrOutside
+};
+
+// Walks the tree once with the range each node's test takes over the box. The answer holds for
+// every point classify_meridian would be given from inside the box: the ranges come from the same
+// arithmetic at the box's nearest and farthest corners, and that arithmetic is monotonic, so no
+// point's rounded value falls outside its box's range. Allocation-free, at most node_count steps.
+[[nodiscard]] BoxClassification classify_meridian_box(const ToolBsp& tool, const MeridianBox& box);
+
+// The meridian box that holds every point of the axis-aligned world box [low, high] as seen from
+// an upright tool (axis +z) with its tip at tip_mm, computed as the query computes each point's
+// r and z (local = point - tip, r = sqrt(x^2 + y^2)).
+[[nodiscard]] MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
+                                               const Eigen::Vector3d& high);
+
+}  // namespace stencil::geometry
