@@ -79,7 +79,7 @@ Answer evaluate(const ToolBsp& tool, const BspNode& node, const MeridianBox& box
   return Answer::Unknown;
 }
 
-constexpr BoxClassification kMixed{BoxCover::Mixed, 0};
+constexpr BoxClassification kMixed{BoxCover::Mixed, 0, 0.0};
 
 }  // namespace
 
@@ -116,17 +116,20 @@ BoxClassification classify_meridian_box(const ToolBsp& tool, const MeridianBox& 
     const BspLink link = answer == Answer::True ? node.when_true : node.when_false;
     switch (link.kind) {
       case BspLink::Kind::Outside:
-        return straddles_boundary ? kMixed : BoxClassification{BoxCover::Outside, 0};
+        return straddles_boundary ? kMixed : BoxClassification{BoxCover::Outside, 0, 0.0};
       case BspLink::Kind::Region:
         if (link.index >= tool.region_count || tool.regions[link.index].surface >= tool.surface_count) {
           return kMixed;
         }
-        if (!straddles_boundary) {
-          return {BoxCover::Region, link.index};
+        {
+          const double deepest = interior_range(tool.surfaces[tool.regions[link.index].surface], box).high;
+          if (!straddles_boundary) {
+            return {BoxCover::Region, link.index, deepest};
+          }
+          return tool.regions[link.index].surface == boundary_surface
+                     ? BoxClassification{BoxCover::RegionOrOutside, link.index, deepest}
+                     : kMixed;
         }
-        return tool.regions[link.index].surface == boundary_surface
-                   ? BoxClassification{BoxCover::RegionOrOutside, link.index}
-                   : kMixed;
       case BspLink::Kind::Node:
         if (link.index <= node_index || link.index >= tool.node_count) {
           return kMixed;

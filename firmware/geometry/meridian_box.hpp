@@ -28,7 +28,9 @@ enum class BoxCover : std::uint8_t {
 
 struct BoxClassification {
   BoxCover cover;
-  std::uint8_t region;  // valid for Region and RegionOrOutside
+  std::uint8_t region;        // valid for Region and RegionOrOutside
+  double deepest_bound_mm;    // valid for Region and RegionOrOutside: no point of the box is
+                              // deeper than this inside the region's surface
 };
 
 // Walks the tree once with the range each node's test takes over the box. The answer holds for

@@ -41,9 +41,14 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
 // on its surface. Either visitor stops the walk by returning false. Iterative, with a fixed stack
 // as deep as the loader allows trees to be.
+enum class Wanted : std::uint8_t {
+  Penetrating,  // only points deeper than the tolerance matter (force, legality)
+  InTool,       // points on the surface matter too (touched triangles)
+};
+
 template <typename VisitPoint, typename VisitLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
-                         VisitPoint&& visit_point, VisitLeaf&& visit_leaf) {
+                         Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
@@ -73,6 +78,12 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         const geometry::BoxClassification cover =
             geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
         if (cover.cover == geometry::BoxCover::Outside) {
+          continue;
+        }
+        // No point of the leaf can be deeper than the tolerance (half of it, so that the lanes'
+        // rounding cannot matter): only touching points, which only the touched set wants.
+        if (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
+            cover.deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm) {
           continue;
         }
         load_leaf(part, node.first_point, node.point_count, leaf);
@@ -171,7 +182,7 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     }
     return true;
   };
-  const Walk walk = walk_points_in_tool(part, part.tool, pose, visit_point, visit_leaf);
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);
   if (walk == Walk::BadTree) {
     return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   }
@@ -189,7 +200,7 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
     return Legality::Fault;
   }
   const Walk walk = walk_points_in_tool(
-      part, part.tool, pose,
+      part, part.tool, pose, Wanted::Penetrating,
       [](std::uint32_t, const geometry::PointClassification& c) {
         return c.contact != geometry::PointContact::Penetrating;
       },
@@ -214,7 +225,7 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
   const std::size_t before = touched.count();
   const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
   static_cast<void>(walk_points_in_tool(
-      part, contact_tool, inflated,
+      part, contact_tool, inflated, Wanted::InTool,
       [&](std::uint32_t i, const geometry::PointClassification&) {
         touched.insert(part.triangle_ids[i]);
         return true;

@@ -35,9 +35,9 @@ void meridian_of(const LeafContacts& leaf, const Eigen::Vector3d& tip, Meridian&
 // or along +y on the axis (classify_at_pose's fixed perpendicular to +z).
 void escape_to_world(const Meridian& m, const LeafLanes& radial, const LeafLanes& axial, LeafContacts& leaf) {
   const auto off_axis = m.r > kOnAxisRadius_mm;
-  const LeafLanes divisor = off_axis.select(m.r, 1.0);
-  leaf.ex = radial * off_axis.select(m.x / divisor, 0.0);
-  leaf.ey = radial * off_axis.select(m.y / divisor, 1.0);
+  const LeafLanes inverse = off_axis.select(m.r, 1.0).inverse();  // one division, not two
+  leaf.ex = radial * off_axis.select(m.x * inverse, 0.0);
+  leaf.ey = radial * off_axis.select(m.y * inverse, 1.0);
   leaf.ez = axial;
 }
 
@@ -67,38 +67,56 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
                           const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
   const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
   const double sign = surface.solid_side == geometry::SolidSide::Below ? 1.0 : -1.0;
+  // Each kind with no more square roots and divisions than it needs: they bound the time here.
   Meridian m;
-  meridian_of(leaf, tip_mm, m);
-  LeafLanes f, radial, axial;
+  m.x = leaf.x - tip_mm.x();
+  m.y = leaf.y - tip_mm.y();
+  m.z = leaf.z - tip_mm.z();
+  LeafLanes f;
   switch (surface.kind) {
     case SurfaceKind::PlaneZ:
       f = m.z - surface.center_z_mm;
-      radial.setZero();
-      axial.setConstant(sign);
+      leaf.ex.setZero();
+      leaf.ey.setZero();
+      leaf.ez.setConstant(sign);
       break;
-    case SurfaceKind::Cylinder:
+    case SurfaceKind::Cylinder: {
+      m.r = (m.x * m.x + m.y * m.y).sqrt();
       f = m.r - surface.radius_mm;
-      radial.setConstant(sign);
-      axial.setZero();
+      const LeafLanes radial = LeafLanes::Constant(sign);
+      escape_to_world(m, radial, LeafLanes::Zero(), leaf);
       break;
-    case SurfaceKind::Sphere:
+    }
+    case SurfaceKind::Sphere: {
+      // Centred on the axis: the meridian gradient (r, dz) / length is the 3-D one (x, y, dz) / length.
+      const LeafLanes dz = m.z - surface.center_z_mm;
+      const LeafLanes length = (m.x * m.x + m.y * m.y + dz * dz).sqrt();
+      f = length - surface.radius_mm;
+      const auto regular = length >= kDegenerateDistance_mm;
+      const LeafLanes inverse = sign * regular.select(length, 1.0).inverse();
+      // At the centre: classify_at_pose's (1, -1) / sqrt(2) in the meridian, radial along +y.
+      leaf.ex = regular.select(m.x * inverse, 0.0);
+      leaf.ey = regular.select(m.y * inverse, kInvSqrt2);
+      leaf.ez = regular.select(dz * inverse, -kInvSqrt2);
+      break;
+    }
     case SurfaceKind::Torus: {
-      const double centre_r = surface.kind == SurfaceKind::Torus ? surface.center_r_mm : 0.0;
-      const LeafLanes dr = m.r - centre_r;
+      m.r = (m.x * m.x + m.y * m.y).sqrt();
+      const LeafLanes dr = m.r - surface.center_r_mm;
       const LeafLanes dz = m.z - surface.center_z_mm;
       const LeafLanes length = (dr * dr + dz * dz).sqrt();
       f = length - surface.radius_mm;
       const auto regular = length >= kDegenerateDistance_mm;
-      const LeafLanes divisor = regular.select(length, 1.0);
-      radial = regular.select(sign * dr / divisor, kInvSqrt2);
-      axial = regular.select(sign * dz / divisor, -kInvSqrt2);
+      const LeafLanes inverse = sign * regular.select(length, 1.0).inverse();
+      const LeafLanes radial = regular.select(dr * inverse, kInvSqrt2);
+      const LeafLanes axial = regular.select(dz * inverse, -kInvSqrt2);
+      escape_to_world(m, radial, axial, leaf);
       break;
     }
     default:
       return false;
   }
-  const LeafLanes depth = -sign * f;  // the interior distance, as classify_meridian computes it
-  escape_to_world(m, radial, axial, leaf);
+  const LeafLanes depth = -sign * f;  // the interior distance to the region's surface
   // Straddling the region's boundary, a point is in the tool exactly when the boundary test that
   // leads to the region passes: -tolerance <= that same interior distance.
   for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
@@ -106,7 +124,7 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
   }
   // classify_meridian calls a point in a region Touching at depth <= tolerance, with depth 0.
   leaf.depth = (depth > geometry::kSurfaceTolerance_mm).select(depth, 0.0);
-  return all_finite(f, radial, axial);
+  return all_finite(f, leaf.ex, leaf.ey) && leaf.ez.isFinite().all();
 }
 
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
@@ -138,11 +156,10 @@ void leaf_forces(const LeafContacts& leaf, double k_world, const Eigen::Vector3d
   const LeafLanes vz = leaf.nz - leaf.ez;
   const LeafLanes length = (vx * vx + vy * vy + vz * vz).sqrt();
   const auto has_direction = length >= kNoDirection;
-  const LeafLanes divisor = has_direction.select(length, 1.0);
-  const LeafLanes scale = has_direction.select(k_world * leaf.depth, 0.0);
-  forces.fx = scale * (vx / divisor);
-  forces.fy = scale * (vy / divisor);
-  forces.fz = scale * (vz / divisor);
+  const LeafLanes scale = has_direction.select(k_world * leaf.depth / length, 0.0);
+  forces.fx = scale * vx;
+  forces.fy = scale * vy;
+  forces.fz = scale * vz;
   const LeafLanes rx = leaf.x - centre.x();
   const LeafLanes ry = leaf.y - centre.y();
   const LeafLanes rz = leaf.z - centre.z();

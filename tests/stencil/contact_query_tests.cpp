@@ -2,6 +2,7 @@
 // free space, legality, and touched triangles marked at the tool's pose.
 #include <cmath>
 #include <limits>
+#include <random>
 
 #include <Eigen/Geometry>
 
@@ -148,4 +149,87 @@ TEST(ContactForceContinuity, ForceChangesSmoothlyAsContactCrossesTheToolsRegions
   CHECK(in_contact > 1000);
   // k_world = 10 N/mm: a 2 um step may change the force by a fraction of 10 * 0.1 = 1 N, never jump by it.
   CHECK_TEXT(largest_jump < 0.1, "the contact force jumped");
+}
+
+TEST_GROUP(ContactQueryOracle){};
+
+// The query settles whole leaves at once (the leaf's box against the tool tree, the points' numbers
+// lane by lane); here every point goes through classify_at_pose on its own, in a plain loop, and
+// the results must agree: count, deepest point, force and torque, legality, touched triangles.
+TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
+  std::mt19937_64 random(404);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (const char* tool_text : {"ball:d=3", "flat:d=3", "bull:d=4,r=1"}) {
+    tablegen::GeneratorOptions options = test::default_job_options(2);
+    options.tool = tablegen::parse_tool(tool_text, "");
+    options.spacing_mm = 0.08;  // a fixed spacing: a flat end's gouge bound would ask for millions
+    options.force = true;
+    const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+    tables::PartTables part{};
+    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+    const ContactParameters parameters{};
+    const double k_world = 10.0;
+    constexpr double kTolerance = 0.002;
+    geometry::ToolBsp contact_tool{};
+    CHECK(build_contact_tool(part.tool.spec, kTolerance, contact_tool));
+    int poses_in_contact = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+      // Tips near the top face, the side faces and the prism's edges, up to 0.6 mm into the part.
+      const double angle = 3.14159265358979323846 * unit(random);
+      const double radius = kApothem_mm + 1.6 * unit(random);
+      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle),
+                                kTop_mm - 0.3 + 0.9 * unit(random));
+      const ToolPose pose = upright_at(tip.x(), tip.y(), tip.z());
+      std::uint32_t count = 0;
+      double deepest = 0.0;
+      Eigen::Vector3d force = Eigen::Vector3d::Zero();
+      Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+      const Eigen::Vector3d centre = tip + parameters.compliance_centre_mm * Eigen::Vector3d::UnitZ();
+      TriangleSet expected_touched;
+      const Eigen::Vector3d inflated_tip = tip - kTolerance * Eigen::Vector3d::UnitZ();
+      for (std::uint32_t i = 0; i < part.point_count(); ++i) {
+        const Eigen::Vector3d p(part.points[i].x_mm, part.points[i].y_mm, part.points[i].z_mm);
+        const Eigen::Vector3d n(part.normals[i].x_mm, part.normals[i].y_mm, part.normals[i].z_mm);
+        if (geometry::classify_at_pose(contact_tool, inflated_tip, Eigen::Vector3d::UnitZ(), p).contact !=
+            geometry::PointContact::Outside) {
+          expected_touched.insert(part.triangle_ids[i]);
+        }
+        const auto c = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), p);
+        if (c.contact != geometry::PointContact::Penetrating) {
+          continue;
+        }
+        ++count;
+        deepest = std::max(deepest, c.depth_mm);
+        const Eigen::Vector3d direction = n - c.escape_direction;
+        if (direction.norm() >= 1e-12) {
+          const Eigen::Vector3d f = k_world * c.depth_mm * direction.normalized();
+          force += f;
+          torque += (p - centre).cross(f);
+        }
+      }
+      const ContactResult result = query_contacts(part, pose, parameters);
+      CHECK(result.status == QueryStatus::Ok);
+      LONGS_EQUAL(count, result.penetrating_points);
+      DOUBLES_EQUAL(deepest, result.max_depth_mm, 1e-12);
+      const double scale = force.norm() > 0.0 ? k_world * deepest / force.norm() : 0.0;
+      CHECK((result.force_n - scale * force).norm() <= 1e-9 * (1.0 + result.force_n.norm()));
+      CHECK((result.torque_nmm - scale * torque).norm() <= 1e-9 * (1.0 + result.torque_nmm.norm()));
+      if (count > 0) {
+        const ContactResult again = query_contacts(part, pose, parameters);
+        CHECK(again.max_depth_mm == result.max_depth_mm);
+        const auto& p = part.points[result.deepest_point];
+        const auto d = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), {p.x_mm, p.y_mm, p.z_mm});
+        DOUBLES_EQUAL(deepest, d.depth_mm, 1e-12);
+        ++poses_in_contact;
+      }
+      CHECK((check_legal(part, pose) == Legality::Legal) == (count == 0));
+      TriangleSet touched;
+      static_cast<void>(mark_touched(part, contact_tool, pose, kTolerance, touched));
+      LONGS_EQUAL(expected_touched.count(), touched.count());
+      for (std::uint32_t id = 0; id < part.triangle_count(); ++id) {
+        CHECK(touched.contains(id) == expected_touched.contains(id));
+      }
+    }
+    CHECK_TEXT(poses_in_contact > 60, tool_text);
+  }
 }

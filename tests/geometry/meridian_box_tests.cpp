@@ -1,0 +1,151 @@
+// A box's answer from the interval walk holds for every point in it, as classify_meridian says
+// point by point; and small boxes are mostly settled, or the query would gain nothing.
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "firmware/geometry/meridian_box.hpp"
+#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "tests/support/sample_tools.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil::geometry;
+using stencil::test::kSampleTools;
+
+namespace {
+
+struct Tally {
+  int boxes = 0;
+  int settled = 0;
+  int region_or_outside = 0;
+};
+
+// Checks the box's answer against classify_meridian at its corners and at random points in it.
+void check_box(const ToolBsp& tool, const MeridianBox& box, std::mt19937_64& random, Tally& tally) {
+  const BoxClassification answer = classify_meridian_box(tool, box);
+  ++tally.boxes;
+  tally.settled += answer.cover != BoxCover::Mixed ? 1 : 0;
+  tally.region_or_outside += answer.cover == BoxCover::RegionOrOutside ? 1 : 0;
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int i = 0; i < 24; ++i) {
+    const double u = i < 4 ? static_cast<double>(i & 1) : unit(random);
+    const double v = i < 4 ? static_cast<double>(i >> 1) : unit(random);
+    const MeridianPoint point{box.r_low_mm + u * (box.r_high_mm - box.r_low_mm),
+                              box.z_low_mm + v * (box.z_high_mm - box.z_low_mm)};
+    const MeridianClassification truth = classify_meridian(tool, point);
+    CHECK(truth.contact != PointContact::BadTree);
+    switch (answer.cover) {
+      case BoxCover::Outside:
+        CHECK(truth.contact == PointContact::Outside);
+        break;
+      case BoxCover::Region:
+      case BoxCover::RegionOrOutside: {
+        const ImplicitSurface& surface = tool.surfaces[tool.regions[answer.region].surface];
+        const double depth = interior_distance(surface, point);
+        CHECK(depth <= answer.deepest_bound_mm);
+        if (answer.cover == BoxCover::Region) {
+          CHECK(truth.contact != PointContact::Outside);
+        }
+        if (truth.contact == PointContact::Outside) {
+          CHECK(depth < -kSurfaceTolerance_mm);  // outside exactly where the region's test fails
+        } else {
+          LONGS_EQUAL(answer.region, truth.region);
+          CHECK(depth >= -kSurfaceTolerance_mm);
+        }
+        break;
+      }
+      case BoxCover::Mixed:
+        break;
+    }
+  }
+}
+
+}  // namespace
+
+TEST_GROUP(MeridianBox){};
+
+TEST(MeridianBox, EverySettledBoxAgreesWithEachOfItsPointsAndSmallBoxesAreMostlySettled) {
+  std::mt19937_64 random(2026);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const auto& sample : kSampleTools) {
+    ToolBsp tool{};
+    CHECK(build_tool_bsp(sample.spec, tool).ok);
+    const double reach = 1.2 * tool.envelope.holder_radius_mm;
+    const double height = 1.1 * tool.envelope.total_length_mm;
+    Tally small;
+    Tally large;
+    for (int i = 0; i < 4000; ++i) {
+      // Sizes from a micrometre to a few millimetres, like leaves of fine and coarse tables.
+      const double size = std::pow(10.0, -3.0 + 3.5 * unit(random));
+      const double r = reach * unit(random);
+      const double z = -0.05 * height + height * unit(random);
+      const MeridianBox box{r, r + size * unit(random), z, z + size * unit(random)};
+      check_box(tool, box, random, size < 0.2 ? small : large);
+    }
+    // Boxes of a leaf's size (well under the tool's features) rarely straddle two tests at once.
+    CHECK_TEXT(small.settled > 9 * small.boxes / 10, sample.name);
+    CHECK_TEXT(small.region_or_outside > 0, sample.name);
+  }
+}
+
+TEST(MeridianBox, BoxesOnTheAxisAndAtTheTipAreSettledCorrectly) {
+  std::mt19937_64 random(5);
+  Tally tally;
+  for (const auto& sample : kSampleTools) {
+    ToolBsp tool{};
+    CHECK(build_tool_bsp(sample.spec, tool).ok);
+    for (const double size : {1e-6, 1e-3, 0.1}) {
+      check_box(tool, {0.0, size, 0.0, size}, random, tally);          // the tip on the axis
+      check_box(tool, {0.0, size, -size, 0.0}, random, tally);         // just below the tip
+      check_box(tool, {0.0, size, 0.5, 0.5 + size}, random, tally);    // inside, on the axis
+    }
+  }
+  CHECK(tally.settled > 0);
+}
+
+TEST(MeridianBox, ADamagedTreeOrABadBoxIsLeftToThePointByPointWalk) {
+  ToolBsp tool{};
+  CHECK(build_tool_bsp(kSampleTools[2].spec, tool).ok);
+  const MeridianBox inside{0.0, 0.01, 0.5, 0.51};
+  CHECK(classify_meridian_box(tool, inside).cover == BoxCover::Region);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK(classify_meridian_box(tool, {nan, 0.01, 0.5, 0.51}).cover == BoxCover::Mixed);
+  CHECK(classify_meridian_box(tool, {0.02, 0.01, 0.5, 0.51}).cover == BoxCover::Mixed);   // low > high
+  CHECK(classify_meridian_box(tool, {-0.1, 0.01, 0.5, 0.51}).cover == BoxCover::Mixed);   // r < 0
+  ToolBsp broken = tool;
+  broken.nodes[0].when_true = {BspLink::Kind::Node, 0};  // a backward link
+  broken.nodes[0].when_false = {BspLink::Kind::Node, 0};
+  CHECK(classify_meridian_box(broken, inside).cover == BoxCover::Mixed);
+  broken = tool;
+  for (auto& surface : broken.surfaces) {
+    surface.radius_mm = nan;
+    surface.center_z_mm = nan;
+  }
+  CHECK(classify_meridian_box(broken, inside).cover == BoxCover::Mixed);
+  broken = tool;
+  broken.node_count = 200;
+  CHECK(classify_meridian_box(broken, inside).cover == BoxCover::Mixed);
+}
+
+TEST(MeridianBox, TheUprightBoxHoldsEveryPointsRadiusAndHeight) {
+  std::mt19937_64 random(9);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int i = 0; i < 20000; ++i) {
+    const Eigen::Vector3d tip(20.0 + 5.0 * unit(random), 10.0 + 5.0 * unit(random), 3.0 + unit(random));
+    // Boxes around the axis, beside it and far from it, down to a micrometre across.
+    const double size = std::pow(10.0, -3.0 + 2.5 * (0.5 + 0.5 * unit(random)));
+    const Eigen::Vector3d low = tip + Eigen::Vector3d(2.0 * unit(random), 2.0 * unit(random), 2.0 * unit(random));
+    const Eigen::Vector3d high = low + size * Eigen::Vector3d(0.5 + 0.5 * unit(random), 0.5 + 0.5 * unit(random), 1.0);
+    const MeridianBox box = upright_meridian_box(tip, low, high);
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3d p((corner & 1) ? high.x() : low.x(), (corner & 2) ? high.y() : low.y(),
+                              (corner & 4) ? high.z() : low.z());
+      const Eigen::Vector3d local = p - tip;
+      const double r = std::sqrt(local.x() * local.x() + local.y() * local.y());
+      CHECK(box.r_low_mm <= r && r <= box.r_high_mm);
+      CHECK(box.z_low_mm <= local.z() && local.z() <= box.z_high_mm);
+    }
+  }
+}
