@@ -130,6 +130,17 @@ Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
 // Below this length the point's normal and the tool's escape direction cancel: no direction.
 constexpr double kNoDirection = 1e-12;
 
+// 0, 1, 2, ... one per lane, to tell a leaf's own lanes from the padding.
+constexpr std::array<double, tables::kMaxLeafPoints> kLaneNumbers = [] {
+  std::array<double, tables::kMaxLeafPoints> numbers{};
+  for (std::size_t lane = 0; lane < numbers.size(); ++lane) {
+    numbers[lane] = static_cast<double>(lane);
+  }
+  return numbers;
+}();
+
+Eigen::Map<const LeafLanes> lane_numbers() { return Eigen::Map<const LeafLanes>(kLaneNumbers.data()); }
+
 }  // namespace
 
 ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pose, const ContactParameters& parameters) {
@@ -168,18 +179,28 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     torque_sum += (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).cross(force);
     return true;
   };
-  // The same per point as visit_point, the arithmetic lane-wise over the leaf, then the sums in
-  // point order (so the result does not depend on how it was computed).
+  // The same per point as visit_point, lane-wise over the leaf, sums included (their order is
+  // fixed by the build, so the same inputs still give the same bits).
   LeafForces forces;
   const auto visit_leaf = [&](const LeafContacts& leaf) {
-    leaf_forces(leaf, k_world, centre, forces);
-    for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-      if (leaf.depth[lane] > geometry::kSurfaceTolerance_mm) {
-        count_depth(leaf.first + lane, leaf.depth[lane]);
-        force_sum += Eigen::Vector3d(forces.fx[lane], forces.fy[lane], forces.fz[lane]);
-        torque_sum += Eigen::Vector3d(forces.tx[lane], forces.ty[lane], forces.tz[lane]);
-      }
+    const auto valid = lane_numbers() < static_cast<double>(leaf.count);  // lanes past count repeat a point
+    const auto penetrating = valid && leaf.depth > geometry::kSurfaceTolerance_mm;
+    const auto count = static_cast<std::uint32_t>(penetrating.count());
+    if (count == 0) {
+      return true;
     }
+    result.penetrating_points += count;
+    Eigen::Index lane = 0;
+    const double deepest = penetrating.select(leaf.depth, 0.0).maxCoeff(&lane);  // the first lane at the maximum
+    if (deepest > result.max_depth_mm) {
+      result.max_depth_mm = deepest;
+      result.deepest_point = leaf.first + static_cast<std::uint32_t>(lane);
+    }
+    leaf_forces(leaf, k_world, centre, forces);
+    force_sum += Eigen::Vector3d(valid.select(forces.fx, 0.0).sum(), valid.select(forces.fy, 0.0).sum(),
+                                 valid.select(forces.fz, 0.0).sum());
+    torque_sum += Eigen::Vector3d(valid.select(forces.tx, 0.0).sum(), valid.select(forces.ty, 0.0).sum(),
+                                  valid.select(forces.tz, 0.0).sum());
     return true;
   };
   const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);

@@ -50,16 +50,23 @@ bool all_finite(const LeafLanes& a, const LeafLanes& b, const LeafLanes& c) {
 void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, LeafContacts& leaf) {
   leaf.first = first;
   leaf.count = count;
-  for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
-    const std::uint32_t i = first + (lane < count ? lane : count - 1);
-    const tables::PackedPoint& p = part.points[i];
-    const tables::PackedPoint& n = part.normals[i];
-    leaf.x[lane] = double{p.x_mm};
-    leaf.y[lane] = double{p.y_mm};
-    leaf.z[lane] = double{p.z_mm};
-    leaf.nx[lane] = double{n.x_mm};
-    leaf.ny[lane] = double{n.y_mm};
-    leaf.nz[lane] = double{n.z_mm};
+  const tables::PackedPoint* points = &part.points[first];
+  const tables::PackedPoint* normals = &part.normals[first];
+  for (std::uint32_t lane = 0; lane < count; ++lane) {
+    leaf.x[lane] = double{points[lane].x_mm};
+    leaf.y[lane] = double{points[lane].y_mm};
+    leaf.z[lane] = double{points[lane].z_mm};
+    leaf.nx[lane] = double{normals[lane].x_mm};
+    leaf.ny[lane] = double{normals[lane].y_mm};
+    leaf.nz[lane] = double{normals[lane].z_mm};
+  }
+  for (std::uint32_t lane = count; lane < tables::kMaxLeafPoints; ++lane) {
+    leaf.x[lane] = leaf.x[count - 1];
+    leaf.y[lane] = leaf.y[count - 1];
+    leaf.z[lane] = leaf.z[count - 1];
+    leaf.nx[lane] = leaf.nx[count - 1];
+    leaf.ny[lane] = leaf.ny[count - 1];
+    leaf.nz[lane] = leaf.nz[count - 1];
   }
 }
 
