@@ -28,11 +28,13 @@ Range function_range(const ImplicitSurface& surface, const MeridianBox& box) {
       const double centre_r = surface.kind == SurfaceKind::Torus ? surface.center_r_mm : 0.0;
       const double near_r = std::min(std::max(centre_r, box.r_low_mm), box.r_high_mm);
       const double near_z = std::min(std::max(surface.center_z_mm, box.z_low_mm), box.z_high_mm);
-      // Every corner, rather than the one that looks farthest: a rounded comparison could pick wrong.
-      const double far = std::max(std::max(surface_function(surface, {box.r_low_mm, box.z_low_mm}),
-                                           surface_function(surface, {box.r_low_mm, box.z_high_mm})),
-                                  std::max(surface_function(surface, {box.r_high_mm, box.z_low_mm}),
-                                           surface_function(surface, {box.r_high_mm, box.z_high_mm})));
+      // The farthest corner pairs the larger squared offset in r with the larger one in z (the
+      // sum separates, and rounded addition and sqrt are monotonic): every corner's value, one sqrt.
+      const double dr_low = box.r_low_mm - centre_r, dr_high = box.r_high_mm - centre_r;
+      const double dz_low = box.z_low_mm - surface.center_z_mm, dz_high = box.z_high_mm - surface.center_z_mm;
+      const double far = std::sqrt(std::max(dr_low * dr_low, dr_high * dr_high) +
+                                   std::max(dz_low * dz_low, dz_high * dz_high)) -
+                         surface.radius_mm;
       return {surface_function(surface, {near_r, near_z}), far};
     }
   }

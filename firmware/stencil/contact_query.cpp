@@ -190,11 +190,15 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
       return true;
     }
     result.penetrating_points += count;
-    Eigen::Index lane = 0;
-    const double deepest = penetrating.select(leaf.depth, 0.0).maxCoeff(&lane);  // the first lane at the maximum
+    // Depth is 0 in lanes that do not penetrate, and padding repeats a real lane: no mask needed.
+    const double deepest = leaf.depth.maxCoeff();
     if (deepest > result.max_depth_mm) {
       result.max_depth_mm = deepest;
-      result.deepest_point = leaf.first + static_cast<std::uint32_t>(lane);
+      std::uint32_t lane = 0;
+      while (lane + 1 < leaf.count && leaf.depth[lane] != deepest) {  // the first lane at the maximum
+        ++lane;
+      }
+      result.deepest_point = leaf.first + lane;
     }
     leaf_forces(leaf, k_world, centre, forces);
     force_sum += Eigen::Vector3d(valid.select(forces.fx, 0.0).sum(), valid.select(forces.fy, 0.0).sum(),

@@ -41,10 +41,6 @@ void escape_to_world(const Meridian& m, const LeafLanes& radial, const LeafLanes
   leaf.ez = axial;
 }
 
-bool all_finite(const LeafLanes& a, const LeafLanes& b, const LeafLanes& c) {
-  return a.isFinite().all() && b.isFinite().all() && c.isFinite().all();
-}
-
 }  // namespace
 
 void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, LeafContacts& leaf) {
@@ -126,12 +122,17 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
   const LeafLanes depth = -sign * f;  // the interior distance to the region's surface
   // Straddling the region's boundary, a point is in the tool exactly when the boundary test that
   // leads to the region passes: -tolerance <= that same interior distance.
-  for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
-    leaf.in_tool[lane] = !or_outside || -geometry::kSurfaceTolerance_mm <= depth[lane];
+  if (or_outside) {
+    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+      leaf.in_tool[lane] = -geometry::kSurfaceTolerance_mm <= depth[lane];
+    }
+  } else {
+    leaf.in_tool.fill(true);
   }
   // classify_meridian calls a point in a region Touching at depth <= tolerance, with depth 0.
   leaf.depth = (depth > geometry::kSurfaceTolerance_mm).select(depth, 0.0);
-  return all_finite(f, leaf.ex, leaf.ey) && leaf.ez.isFinite().all();
+  // An infinity or NaN in any of them makes the sum non-finite (inf - inf is NaN).
+  return (f + leaf.ex + leaf.ey + leaf.ez).isFinite().all();
 }
 
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
