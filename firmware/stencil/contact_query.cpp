@@ -130,16 +130,6 @@ Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
 // Below this length the point's normal and the tool's escape direction cancel: no direction.
 constexpr double kNoDirection = 1e-12;
 
-// 0, 1, 2, ... one per lane, to tell a leaf's own lanes from the padding.
-constexpr std::array<double, tables::kMaxLeafPoints> kLaneNumbers = [] {
-  std::array<double, tables::kMaxLeafPoints> numbers{};
-  for (std::size_t lane = 0; lane < numbers.size(); ++lane) {
-    numbers[lane] = static_cast<double>(lane);
-  }
-  return numbers;
-}();
-
-Eigen::Map<const LeafLanes> lane_numbers() { return Eigen::Map<const LeafLanes>(kLaneNumbers.data()); }
 
 }  // namespace
 
@@ -183,15 +173,16 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   // fixed by the build, so the same inputs still give the same bits).
   LeafForces forces;
   const auto visit_leaf = [&](const LeafContacts& leaf) {
-    const auto valid = lane_numbers() < static_cast<double>(leaf.count);  // lanes past count repeat a point
-    const auto penetrating = valid && leaf.depth > geometry::kSurfaceTolerance_mm;
-    const auto count = static_cast<std::uint32_t>(penetrating.count());
-    if (count == 0) {
+    // Depth is 0 in every lane that does not penetrate (padding included), so is its force.
+    const double deepest = leaf.depth.maxCoeff();
+    if (!(deepest > geometry::kSurfaceTolerance_mm)) {
       return true;
     }
+    std::uint32_t count = 0;
+    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+      count += leaf.depth[lane] > geometry::kSurfaceTolerance_mm ? 1U : 0U;
+    }
     result.penetrating_points += count;
-    // Depth is 0 in lanes that do not penetrate, and padding repeats a real lane: no mask needed.
-    const double deepest = leaf.depth.maxCoeff();
     if (deepest > result.max_depth_mm) {
       result.max_depth_mm = deepest;
       std::uint32_t lane = 0;
@@ -201,10 +192,8 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
       result.deepest_point = leaf.first + lane;
     }
     leaf_forces(leaf, k_world, centre, forces);
-    force_sum += Eigen::Vector3d(valid.select(forces.fx, 0.0).sum(), valid.select(forces.fy, 0.0).sum(),
-                                 valid.select(forces.fz, 0.0).sum());
-    torque_sum += Eigen::Vector3d(valid.select(forces.tx, 0.0).sum(), valid.select(forces.ty, 0.0).sum(),
-                                  valid.select(forces.tz, 0.0).sum());
+    force_sum += Eigen::Vector3d(forces.fx.sum(), forces.fy.sum(), forces.fz.sum());
+    torque_sum += Eigen::Vector3d(forces.tx.sum(), forces.ty.sum(), forces.tz.sum());
     return true;
   };
   const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);
@@ -229,8 +218,7 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
       [](std::uint32_t, const geometry::PointClassification& c) {
         return c.contact != geometry::PointContact::Penetrating;
       },
-      // Lanes past the leaf's count repeat its last point, so all lanes can be tested.
-      [](const LeafContacts& leaf) { return !(leaf.depth > geometry::kSurfaceTolerance_mm).any(); });
+      [](const LeafContacts& leaf) { return !(leaf.depth.maxCoeff() > geometry::kSurfaceTolerance_mm); });
   switch (walk) {
     case Walk::Finished:
       return Legality::Legal;

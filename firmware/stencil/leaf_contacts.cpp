@@ -19,6 +19,10 @@ constexpr double kInvSqrt2 = 0.70710678118654752;
 // Below this length a point's normal and the tool's escape direction cancel: no direction.
 constexpr double kNoDirection = 1e-12;
 
+// Eigen 3.4 runs select() and boolean reductions a lane at a time, so the kernels below use only
+// arithmetic, min/max and sums over the lanes (which it vectorises), and patch the rare lanes a
+// select would have treated apart (a point on the axis or at a centre) in a plain loop afterwards.
+
 struct Meridian {
   LeafLanes x, y, z;  // relative to the tip
   LeafLanes r;
@@ -34,11 +38,30 @@ void meridian_of(const LeafContacts& leaf, const Eigen::Vector3d& tip, Meridian&
 // The meridian escape direction (radial, axial) turned into the world: radial along (x, y) / r,
 // or along +y on the axis (classify_at_pose's fixed perpendicular to +z).
 void escape_to_world(const Meridian& m, const LeafLanes& radial, const LeafLanes& axial, LeafContacts& leaf) {
-  const auto off_axis = m.r > kOnAxisRadius_mm;
-  const LeafLanes inverse = off_axis.select(m.r, 1.0).inverse();  // one division, not two
-  leaf.ex = radial * off_axis.select(m.x * inverse, 0.0);
-  leaf.ey = radial * off_axis.select(m.y * inverse, 1.0);
+  const LeafLanes inverse = m.r.max(kOnAxisRadius_mm).inverse();  // one division, not two
+  leaf.ex = radial * (m.x * inverse);
+  leaf.ey = radial * (m.y * inverse);
   leaf.ez = axial;
+  if (!(m.r.minCoeff() > kOnAxisRadius_mm)) {
+    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+      if (!(m.r[lane] > kOnAxisRadius_mm)) {
+        leaf.ex[lane] = 0.0;
+        leaf.ey[lane] = radial[lane];
+      }
+    }
+  }
+}
+
+// Depth 0 where it is not beyond the tolerance (classify_meridian's Touching), and in the lanes
+// past the leaf's count, so sums and maxima may run over every lane.
+void settle_depths(const LeafLanes& interior, LeafContacts& leaf) {
+  for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+    leaf.depth[lane] = interior[lane] > geometry::kSurfaceTolerance_mm ? interior[lane] : 0.0;
+  }
+  for (std::uint32_t lane = leaf.count; lane < tables::kMaxLeafPoints; ++lane) {
+    leaf.depth[lane] = 0.0;
+    leaf.in_tool[lane] = false;
+  }
 }
 
 }  // namespace
@@ -95,12 +118,20 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
       const LeafLanes dz = m.z - surface.center_z_mm;
       const LeafLanes length = (m.x * m.x + m.y * m.y + dz * dz).sqrt();
       f = length - surface.radius_mm;
-      const auto regular = length >= kDegenerateDistance_mm;
-      const LeafLanes inverse = sign * regular.select(length, 1.0).inverse();
-      // At the centre: classify_at_pose's (1, -1) / sqrt(2) in the meridian, radial along +y.
-      leaf.ex = regular.select(m.x * inverse, 0.0);
-      leaf.ey = regular.select(m.y * inverse, kInvSqrt2);
-      leaf.ez = regular.select(dz * inverse, -kInvSqrt2);
+      const LeafLanes inverse = sign * length.max(kDegenerateDistance_mm).inverse();
+      leaf.ex = m.x * inverse;
+      leaf.ey = m.y * inverse;
+      leaf.ez = dz * inverse;
+      if (!(length.minCoeff() >= kDegenerateDistance_mm)) {
+        for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+          if (!(length[lane] >= kDegenerateDistance_mm)) {
+            // At the centre: classify_at_pose's (1, -1) / sqrt(2) in the meridian, radial along +y.
+            leaf.ex[lane] = 0.0;
+            leaf.ey[lane] = kInvSqrt2;
+            leaf.ez[lane] = -kInvSqrt2;
+          }
+        }
+      }
       break;
     }
     case SurfaceKind::Torus: {
@@ -109,10 +140,17 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
       const LeafLanes dz = m.z - surface.center_z_mm;
       const LeafLanes length = (dr * dr + dz * dz).sqrt();
       f = length - surface.radius_mm;
-      const auto regular = length >= kDegenerateDistance_mm;
-      const LeafLanes inverse = sign * regular.select(length, 1.0).inverse();
-      const LeafLanes radial = regular.select(dr * inverse, kInvSqrt2);
-      const LeafLanes axial = regular.select(dz * inverse, -kInvSqrt2);
+      const LeafLanes inverse = sign * length.max(kDegenerateDistance_mm).inverse();
+      LeafLanes radial = dr * inverse;
+      LeafLanes axial = dz * inverse;
+      if (!(length.minCoeff() >= kDegenerateDistance_mm)) {
+        for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+          if (!(length[lane] >= kDegenerateDistance_mm)) {
+            radial[lane] = kInvSqrt2;
+            axial[lane] = -kInvSqrt2;
+          }
+        }
+      }
       escape_to_world(m, radial, axial, leaf);
       break;
     }
@@ -129,16 +167,15 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
   } else {
     leaf.in_tool.fill(true);
   }
-  // classify_meridian calls a point in a region Touching at depth <= tolerance, with depth 0.
-  leaf.depth = (depth > geometry::kSurfaceTolerance_mm).select(depth, 0.0);
-  // An infinity or NaN in any of them makes the sum non-finite (inf - inf is NaN).
-  return (f + leaf.ex + leaf.ey + leaf.ez).isFinite().all();
+  settle_depths(depth, leaf);
+  // An infinity or NaN anywhere makes the sum non-finite (inf - inf is NaN).
+  return std::isfinite((f + leaf.ex + leaf.ey + leaf.ez).sum());
 }
 
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
   Meridian m;
   meridian_of(leaf, tip_mm, m);
-  LeafLanes radial, axial;
+  LeafLanes radial, axial, interior;
   for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
     const Eigen::Vector3d local(m.x[lane], m.y[lane], m.z[lane]);
     geometry::MeridianClassification c{geometry::PointContact::Outside, 0, 0.0, {0.0, 0.0}};
@@ -150,11 +187,12 @@ bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& t
     }
     const bool inside = c.contact != geometry::PointContact::Outside;
     leaf.in_tool[lane] = inside;
-    leaf.depth[lane] = inside ? c.depth_mm : 0.0;
+    interior[lane] = inside ? c.depth_mm : 0.0;
     radial[lane] = inside ? c.escape.radial : 0.0;
     axial[lane] = inside ? c.escape.axial : 0.0;
   }
   escape_to_world(m, radial, axial, leaf);
+  settle_depths(interior, leaf);
   return true;
 }
 
@@ -163,8 +201,14 @@ void leaf_forces(const LeafContacts& leaf, double k_world, const Eigen::Vector3d
   const LeafLanes vy = leaf.ny - leaf.ey;
   const LeafLanes vz = leaf.nz - leaf.ez;
   const LeafLanes length = (vx * vx + vy * vy + vz * vz).sqrt();
-  const auto has_direction = length >= kNoDirection;
-  const LeafLanes scale = has_direction.select(k_world * leaf.depth / length, 0.0);
+  LeafLanes scale = k_world * leaf.depth / length.max(kNoDirection);
+  if (!(length.minCoeff() >= kNoDirection)) {
+    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+      if (!(length[lane] >= kNoDirection)) {
+        scale[lane] = 0.0;  // the normal and the escape direction cancel: no direction
+      }
+    }
+  }
   forces.fx = scale * vx;
   forces.fy = scale * vy;
   forces.fz = scale * vz;

@@ -22,9 +22,9 @@ struct LeafContacts {
   LeafLanes x, y, z;     // world mm
   LeafLanes nx, ny, nz;  // the points' normals
   LeafLanes depth;       // inside the tool's surface, mm: penetrating beyond kSurfaceTolerance_mm;
-                         // 0 for points outside the tool
+                         // 0 for points outside the tool or on its surface, and past count
   LeafLanes ex, ey, ez;  // escape direction in world frame; 0 for points outside the tool
-  std::array<bool, tables::kMaxLeafPoints> in_tool;  // touching or penetrating
+  std::array<bool, tables::kMaxLeafPoints> in_tool;  // touching or penetrating; false past count
 };
 
 // Widens the leaf's points and normals into the lanes. count must be 1 to kMaxLeafPoints and the
