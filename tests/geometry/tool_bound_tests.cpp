@@ -118,3 +118,20 @@ TEST(ToolBound, EachBoundIsReachedByTheEnvelope) {
     }
   }
 }
+
+TEST(ToolBound, TheUprightShortcutGivesTheBoundOfTheGeneralFormula) {
+  // The upright axis takes precomputed reaches; an axis a hair off upright takes the square roots.
+  // Their bounds may differ by the tilt only, never more.
+  for (const auto& sample : stencil::test::kSampleTools) {
+    ToolBsp tool{};
+    CHECK(build_tool_bsp(sample.spec, tool).ok);
+    const Eigen::Vector3d tip(12.0, 7.5, 3.25);
+    const Kdop14 upright = tool_kdop(tool.envelope, tip, Eigen::Vector3d::UnitZ());
+    const Eigen::Vector3d tilted = Eigen::Vector3d(1e-12, 0.0, 1.0).normalized();
+    const Kdop14 general = tool_kdop(tool.envelope, tip, tilted);
+    for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+      DOUBLES_EQUAL(general.min[slab], upright.min[slab], 1e-9);
+      DOUBLES_EQUAL(general.max[slab], upright.max[slab], 1e-9);
+    }
+  }
+}
