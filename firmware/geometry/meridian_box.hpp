@@ -17,20 +17,33 @@ struct MeridianBox {
 };
 
 enum class BoxCover : std::uint8_t {
-  Outside,         // every point of the box is outside the tool
-  Region,          // every point of the box reaches region `region` (inside the tool or on its surface)
-  RegionOrOutside, // the box straddles the boundary surface of region `region` and nothing else:
-                   // a point reaches the region exactly when its interior distance to the region's
-                   // surface is at least -kSurfaceTolerance_mm, and is outside the tool otherwise
-  Mixed,           // the box straddles other tests of the tree (or the tree or box is unusable):
-                   // ask per point
+  Outside,          // every point of the box is outside the tool
+  Region,           // every point of the box reaches region `region` (inside the tool or on its surface)
+  RegionOrOutside,  // the box straddles the boundary surface of region `region` and nothing else:
+                    // a point reaches the region exactly when its interior distance to the region's
+                    // surface is at least -kSurfaceTolerance_mm, and is outside the tool otherwise
+  SplitAtZ,         // the box straddles a partition plane z = split_z_mm of the tree and nothing
+                    // else there: a point with z - split_z_mm < 0 is settled as `below` says, any
+                    // other as `above` says (each Outside, Region or RegionOrOutside)
+  Mixed,            // the box straddles other tests of the tree (or the tree or box is unusable):
+                    // ask per point
+};
+
+// One side's answer: Outside, Region or RegionOrOutside, as above.
+struct BoxPart {
+  BoxCover cover;
+  std::uint8_t region;       // valid for Region and RegionOrOutside
+  double deepest_bound_mm;   // no point is deeper than this inside the region's surface
 };
 
 struct BoxClassification {
   BoxCover cover;
-  std::uint8_t region;        // valid for Region and RegionOrOutside
-  double deepest_bound_mm;    // valid for Region and RegionOrOutside: no point of the box is
-                              // deeper than this inside the region's surface
+  std::uint8_t region;       // valid for Region and RegionOrOutside
+  double deepest_bound_mm;   // Region, RegionOrOutside: no point of the box is deeper than this
+                             // inside the region's surface; SplitAtZ: the larger of the two sides'
+  double split_z_mm;         // SplitAtZ only
+  BoxPart below;             // SplitAtZ only
+  BoxPart above;             // SplitAtZ only
 };
 
 // Walks the tree once with the range each node's test takes over the box. The answer holds for

@@ -36,8 +36,9 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
 // end). For the upright tool each remaining leaf goes to visit_leaf as a whole, its points' depths
 // and escape directions computed lane-wise: from one region's surface when the leaf's box lies in
-// that region (no walk of the tool tree per point), point by point through the tool tree when the
-// box straddles its tests, skipped when the box is wholly outside. For any other axis each point
+// that region or just straddles its boundary (no walk of the tool tree per point), from the two
+// sides' regions when it straddles a partition plane, point by point through the tool tree when
+// it straddles other tests, skipped when the box is wholly outside. For any other axis each point
 // goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
 // on its surface. Either visitor stops the walk by returning false. Iterative, with a fixed stack
 // as deep as the loader allows trees to be.
@@ -87,11 +88,21 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           continue;
         }
         load_leaf(part, node.first_point, node.point_count, leaf);
-        const bool finite =
-            cover.cover == geometry::BoxCover::Mixed
-                ? mixed_leaf_contacts(tool, pose.tip_mm, leaf)
-                : region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
-                                       pose.tip_mm, leaf);
+        bool finite = false;
+        switch (cover.cover) {
+          case geometry::BoxCover::Region:
+          case geometry::BoxCover::RegionOrOutside:
+            finite = region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
+                                          pose.tip_mm, leaf);
+            break;
+          case geometry::BoxCover::SplitAtZ:
+            finite = split_leaf_contacts(tool, cover, pose.tip_mm, leaf);
+            break;
+          case geometry::BoxCover::Outside:  // skipped above
+          case geometry::BoxCover::Mixed:
+            finite = mixed_leaf_contacts(tool, pose.tip_mm, leaf);
+            break;
+        }
         if (!finite) {
           return Walk::BadTree;
         }

@@ -172,6 +172,46 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
   return std::isfinite((f + leaf.ex + leaf.ey + leaf.ez).sum());
 }
 
+namespace {
+
+bool part_contacts(const geometry::ToolBsp& tool, const geometry::BoxPart& part, const Eigen::Vector3d& tip_mm,
+                   LeafContacts& leaf) {
+  if (part.cover == geometry::BoxCover::Outside) {
+    leaf.depth.setZero();
+    leaf.ex.setZero();
+    leaf.ey.setZero();
+    leaf.ez.setZero();
+    leaf.in_tool.fill(false);
+    return true;
+  }
+  return region_leaf_contacts(tool, part.region, part.cover == geometry::BoxCover::RegionOrOutside, tip_mm, leaf);
+}
+
+}  // namespace
+
+bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                         const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
+  if (!part_contacts(tool, cover.below, tip_mm, leaf)) {
+    return false;
+  }
+  const LeafLanes depth = leaf.depth, ex = leaf.ex, ey = leaf.ey, ez = leaf.ez;
+  const std::array<bool, tables::kMaxLeafPoints> in_tool = leaf.in_tool;
+  if (!part_contacts(tool, cover.above, tip_mm, leaf)) {
+    return false;
+  }
+  for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+    // classify_meridian's partition test, on the same z: below when z - split < 0.
+    if ((leaf.z[lane] - tip_mm.z()) - cover.split_z_mm < 0.0) {
+      leaf.depth[lane] = depth[lane];
+      leaf.ex[lane] = ex[lane];
+      leaf.ey[lane] = ey[lane];
+      leaf.ez[lane] = ez[lane];
+      leaf.in_tool[lane] = in_tool[lane];
+    }
+  }
+  return true;
+}
+
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
   Meridian m;
   meridian_of(leaf, tip_mm, m);

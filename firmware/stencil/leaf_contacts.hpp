@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 
+#include "firmware/geometry/meridian_box.hpp"
 #include "firmware/geometry/tool_bsp.hpp"
 #include "firmware/tables/part_tables.hpp"
 #include "firmware/tables/table_format.hpp"
@@ -37,6 +38,12 @@ void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_
 // tree. False when a result is not finite (a damaged tool tree): a fault.
 [[nodiscard]] bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside,
                                         const Eigen::Vector3d& tip_mm, LeafContacts& leaf);
+
+// The leaf straddles a plane z = split_z_mm of the tool tree (geometry::classify_meridian_box's
+// SplitAtZ): each side's part settled as above, and each point takes its own side's numbers. False
+// as above.
+[[nodiscard]] bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                                       const Eigen::Vector3d& tip_mm, LeafContacts& leaf);
 
 // The leaf straddles the tool's tests: each point through the tool tree (classify_meridian), the
 // arithmetic before and after it still over the lanes. False on a damaged tree.
