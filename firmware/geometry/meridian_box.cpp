@@ -12,7 +12,8 @@ struct Range {
   double high;
 };
 
-enum class Answer : std::uint8_t { True, False, Unknown };
+// Invalid: a NaN in the tree's numbers, which classify_meridian reports as a fault per point.
+enum class Answer : std::uint8_t { True, False, Unknown, Invalid };
 
 // The range of the surface's natural function over the box. For a plane or a cylinder f is
 // monotonic in z or r; for a sphere or torus it is a distance from a centre, least at the box point
@@ -56,7 +57,7 @@ Answer evaluate(const ToolBsp& tool, const BspNode& node, const MeridianBox& box
     case NodeTest::InsideBoundary: {  // -tolerance <= interior distance
       const Range inside = interior_range(a, box);
       if (is_nan(inside)) {
-        return Answer::Unknown;
+        return Answer::Invalid;
       }
       return -kSurfaceTolerance_mm <= inside.low ? Answer::True
              : -kSurfaceTolerance_mm <= inside.high ? Answer::Unknown
@@ -65,7 +66,7 @@ Answer evaluate(const ToolBsp& tool, const BspNode& node, const MeridianBox& box
     case NodeTest::BelowPartition: {  // f < 0
       const Range f = function_range(a, box);
       if (is_nan(f)) {
-        return Answer::Unknown;
+        return Answer::Invalid;
       }
       return f.high < 0.0 ? Answer::True : f.low < 0.0 ? Answer::Unknown : Answer::False;
     }
@@ -73,12 +74,12 @@ Answer evaluate(const ToolBsp& tool, const BspNode& node, const MeridianBox& box
       const Range left = interior_range(a, box);
       const Range right = interior_range(tool.surfaces[node.surface_b], box);
       if (is_nan(left) || is_nan(right)) {
-        return Answer::Unknown;
+        return Answer::Invalid;
       }
       return left.high <= right.low ? Answer::True : left.low <= right.high ? Answer::Unknown : Answer::False;
     }
   }
-  return Answer::Unknown;
+  return Answer::Invalid;
 }
 
 constexpr BoxPart kMixedPart{BoxCover::Mixed, 0, 0.0};
@@ -136,6 +137,9 @@ Settled settle(const ToolBsp& tool, const MeridianBox& box, BspLink link, std::s
       return mixed;
     }
     Answer answer = evaluate(tool, node, box);
+    if (answer == Answer::Invalid) {
+      return mixed;
+    }
     if (answer == Answer::Unknown) {
       if (node.test == NodeTest::BelowPartition && tool.surfaces[node.surface_a].kind == SurfaceKind::PlaneZ &&
           may_split && !straddles_boundary) {

@@ -3,7 +3,6 @@
 
 #include <cmath>
 
-#include "firmware/geometry/upright_tool.hpp"
 
 namespace stencil::engine {
 namespace {
@@ -217,11 +216,9 @@ bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& t
   meridian_of(leaf, tip_mm, m);
   LeafLanes radial, axial, interior;
   for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
-    const Eigen::Vector3d local(m.x[lane], m.y[lane], m.z[lane]);
-    geometry::MeridianClassification c{geometry::PointContact::Outside, 0, 0.0, {0.0, 0.0}};
-    if (geometry::upright_point_may_be_inside(tool, local, 0.0)) {
-      c = geometry::classify_meridian(tool, {m.r[lane], m.z[lane]});
-    }
+    // No outline pre-filter here: it would drop points touching the surface from just outside,
+    // which the settled leaves keep; the tool tree decides them all alike.
+    const geometry::MeridianClassification c = geometry::classify_meridian(tool, {m.r[lane], m.z[lane]});
     if (c.contact == geometry::PointContact::BadTree) {
       return false;
     }

@@ -1,5 +1,6 @@
 // A box's answer from the interval walk holds for every point in it, as classify_meridian says
 // point by point; and small boxes are mostly settled, or the query would gain nothing.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -150,6 +151,17 @@ TEST(MeridianBox, ADamagedTreeOrABadBoxIsLeftToThePointByPointWalk) {
     surface.center_z_mm = nan;
   }
   CHECK(classify_meridian_box(broken, inside).cover == BoxCover::Mixed);
+  // One NaN partition plane (the ball's equator) across the box: a fault per point, so Mixed, never
+  // a split at NaN.
+  for (std::uint8_t i = 0; i < tool.surface_count; ++i) {
+    if (tool.surfaces[i].kind == SurfaceKind::PlaneZ && tool.surfaces[i].center_z_mm == 1.5) {
+      broken = tool;
+      broken.surfaces[i].center_z_mm = nan;
+      CHECK(classify_meridian_box(broken, {2.0, 2.1, 0.5, 0.6}).cover == BoxCover::Mixed);
+      CHECK(classify_meridian_box(broken, {0.2, 0.3, 1.49, 1.51}).cover == BoxCover::Mixed);
+      CHECK(classify_meridian(broken, {2.05, 0.55}).contact == PointContact::BadTree);
+    }
+  }
   broken = tool;
   broken.node_count = 200;
   CHECK(classify_meridian_box(broken, inside).cover == BoxCover::Mixed);
@@ -165,13 +177,26 @@ TEST(MeridianBox, TheUprightBoxHoldsEveryPointsRadiusAndHeight) {
     const Eigen::Vector3d low = tip + Eigen::Vector3d(2.0 * unit(random), 2.0 * unit(random), 2.0 * unit(random));
     const Eigen::Vector3d high = low + size * Eigen::Vector3d(0.5 + 0.5 * unit(random), 0.5 + 0.5 * unit(random), 1.0);
     const MeridianBox box = upright_meridian_box(tip, low, high);
-    for (int corner = 0; corner < 8; ++corner) {
-      const Eigen::Vector3d p((corner & 1) ? high.x() : low.x(), (corner & 2) ? high.y() : low.y(),
-                              (corner & 4) ? high.z() : low.z());
+    // The corners, the point of the footprint nearest the axis, and random points inside.
+    const Eigen::Vector3d nearest(std::clamp(tip.x(), low.x(), high.x()), std::clamp(tip.y(), low.y(), high.y()),
+                                  low.z());
+    for (int sample = 0; sample < 16; ++sample) {
+      Eigen::Vector3d p;
+      if (sample < 8) {
+        p = {(sample & 1) ? high.x() : low.x(), (sample & 2) ? high.y() : low.y(), (sample & 4) ? high.z() : low.z()};
+      } else if (sample == 8) {
+        p = nearest;
+      } else {
+        const Eigen::Vector3d u(0.5 + 0.5 * unit(random), 0.5 + 0.5 * unit(random), 0.5 + 0.5 * unit(random));
+        p = low + u.cwiseProduct(high - low);
+      }
       const Eigen::Vector3d local = p - tip;
       const double r = std::sqrt(local.x() * local.x() + local.y() * local.y());
       CHECK(box.r_low_mm <= r && r <= box.r_high_mm);
       CHECK(box.z_low_mm <= local.z() && local.z() <= box.z_high_mm);
     }
+    // And it is tight: the nearest point's radius is the lower bound.
+    const Eigen::Vector3d near_local = nearest - tip;
+    DOUBLES_EQUAL(std::sqrt(near_local.x() * near_local.x() + near_local.y() * near_local.y()), box.r_low_mm, 1e-12);
   }
 }

@@ -174,11 +174,13 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
     CHECK(build_contact_tool(part.tool.spec, kTolerance, contact_tool));
     int poses_in_contact = 0;
     for (int trial = 0; trial < 300; ++trial) {
-      // Tips near the top face, the side faces and the prism's edges, up to 0.6 mm into the part.
+      // Tips near the top face, the side faces and the prism's edges, up to 0.6 mm into the part,
+      // and low beside the side faces so that the tool's partition planes (a ball's equator, a
+      // bull-nose's corner top) cross the faces.
       const double angle = 3.14159265358979323846 * unit(random);
       const double radius = kApothem_mm + 1.6 * unit(random);
-      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle),
-                                kTop_mm - 0.3 + 0.9 * unit(random));
+      const double height = trial % 2 == 0 ? kTop_mm - 0.3 + 0.9 * unit(random) : 3.0 + 2.5 * unit(random);
+      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle), height);
       const ToolPose pose = upright_at(tip.x(), tip.y(), tip.z());
       std::uint32_t count = 0;
       double deepest = 0.0;
@@ -215,8 +217,10 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       CHECK((result.force_n - scale * force).norm() <= 1e-9 * (1.0 + result.force_n.norm()));
       CHECK((result.torque_nmm - scale * torque).norm() <= 1e-9 * (1.0 + result.torque_nmm.norm()));
       if (count > 0) {
-        const ContactResult again = query_contacts(part, pose, parameters);
-        CHECK(again.max_depth_mm == result.max_depth_mm);
+        const ContactResult again = query_contacts(part, pose, parameters);  // the same bits
+        CHECK(again.max_depth_mm == result.max_depth_mm && again.deepest_point == result.deepest_point &&
+              again.penetrating_points == result.penetrating_points && again.force_n == result.force_n &&
+              again.torque_nmm == result.torque_nmm);
         const auto& p = part.points[result.deepest_point];
         const auto d = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), {p.x_mm, p.y_mm, p.z_mm});
         DOUBLES_EQUAL(deepest, d.depth_mm, 1e-12);
