@@ -1,7 +1,6 @@
 // The query: the tool's 14-DOP against the points' tree, then each nearby point through the tool BSP.
 #include "firmware/stencil/contact_query.hpp"
 
-#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -138,8 +137,6 @@ Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
   return {n.x_mm, n.y_mm, n.z_mm};
 }
 
-// Below this length the point's normal and the tool's escape direction cancel: no direction.
-constexpr double kNoDirection = 1e-12;
 
 
 }  // namespace

@@ -15,8 +15,6 @@ constexpr double kOnAxisRadius_mm = 1e-12;
 constexpr double kDegenerateDistance_mm = 1e-12;
 constexpr double kInvSqrt2 = 0.70710678118654752;
 
-// Below this length a point's normal and the tool's escape direction cancel: no direction.
-constexpr double kNoDirection = 1e-12;
 
 // Eigen 3.4 runs select() and boolean reductions a lane at a time, so the kernels below use only
 // arithmetic, min/max and sums over the lanes (which it vectorises), and patch the rare lanes a
@@ -24,15 +22,16 @@ constexpr double kNoDirection = 1e-12;
 
 struct Meridian {
   LeafLanes x, y, z;  // relative to the tip
-  LeafLanes r;
+  LeafLanes r;        // set only where a kernel needs it (a square root per point)
 };
 
-void meridian_of(const LeafContacts& leaf, const Eigen::Vector3d& tip, Meridian& m) {
+void offsets_from(const LeafContacts& leaf, const Eigen::Vector3d& tip, Meridian& m) {
   m.x = leaf.x - tip.x();
   m.y = leaf.y - tip.y();
   m.z = leaf.z - tip.z();
-  m.r = (m.x * m.x + m.y * m.y).sqrt();
 }
+
+void radii_of(Meridian& m) { m.r = (m.x * m.x + m.y * m.y).sqrt(); }
 
 // The meridian escape direction (radial, axial) turned into the world: radial along (x, y) / r,
 // or along +y on the axis (classify_at_pose's fixed perpendicular to +z).
@@ -94,9 +93,7 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
   const double sign = surface.solid_side == geometry::SolidSide::Below ? 1.0 : -1.0;
   // Each kind with no more square roots and divisions than it needs: they bound the time here.
   Meridian m;
-  m.x = leaf.x - tip_mm.x();
-  m.y = leaf.y - tip_mm.y();
-  m.z = leaf.z - tip_mm.z();
+  offsets_from(leaf, tip_mm, m);
   LeafLanes f;
   switch (surface.kind) {
     case SurfaceKind::PlaneZ:
@@ -106,7 +103,7 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
       leaf.ez.setConstant(sign);
       break;
     case SurfaceKind::Cylinder: {
-      m.r = (m.x * m.x + m.y * m.y).sqrt();
+      radii_of(m);
       f = m.r - surface.radius_mm;
       const LeafLanes radial = LeafLanes::Constant(sign);
       escape_to_world(m, radial, LeafLanes::Zero(), leaf);
@@ -134,7 +131,7 @@ bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bo
       break;
     }
     case SurfaceKind::Torus: {
-      m.r = (m.x * m.x + m.y * m.y).sqrt();
+      radii_of(m);
       const LeafLanes dr = m.r - surface.center_r_mm;
       const LeafLanes dz = m.z - surface.center_z_mm;
       const LeafLanes length = (dr * dr + dz * dz).sqrt();
@@ -213,7 +210,8 @@ bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClass
 
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, const Eigen::Vector3d& tip_mm, LeafContacts& leaf) {
   Meridian m;
-  meridian_of(leaf, tip_mm, m);
+  offsets_from(leaf, tip_mm, m);
+  radii_of(m);
   LeafLanes radial, axial, interior;
   for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
     // No outline pre-filter here: it would drop points touching the surface from just outside,

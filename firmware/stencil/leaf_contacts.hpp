@@ -17,6 +17,10 @@ namespace stencil::engine {
 
 using LeafLanes = Eigen::Array<double, tables::kMaxLeafPoints, 1>;
 
+// Below this length a point's normal and the tool's escape direction cancel: the point gives no
+// force direction (the same threshold for the per-point path of the query and the lanes).
+inline constexpr double kNoDirection = 1e-12;
+
 struct LeafContacts {
   std::uint32_t first;   // table index of the leaf's first point
   std::uint32_t count;   // its points (1 to 32); lanes past count repeat the last point
