@@ -4,58 +4,18 @@
 #include <algorithm>
 #include <cmath>
 
+#include "firmware/stencil/sweep.hpp"
+
 namespace stencil::engine {
 
 VirtualTool::VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm)
     : part_(part),
       tip_(home_tip_mm),
       box_high_(part.header.workspace_mm[0], part.header.workspace_mm[1], part.header.workspace_mm[2]),
-      sweep_step_(0.5 * part.header.covering_radius_mm) {}
-
-bool VirtualTool::inside_box(const Eigen::Vector3d& tip) const {
-  return (tip.array() >= 0.0).all() && (tip.array() <= box_high_.array()).all();
-}
+      sweep_step_(engine::sweep_step_mm(part)) {}
 
 Eigen::Vector3d VirtualTool::clamp_to_box(const Eigen::Vector3d& tip) const {
   return tip.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(box_high_);
-}
-
-Legality VirtualTool::legal(const Eigen::Vector3d& tip) const {
-  if (!inside_box(tip)) {
-    return Legality::Illegal;
-  }
-  return check_legal(part_, {tip, Eigen::Vector3d::UnitZ()});
-}
-
-// Checks the straight move from the current tip in sub-steps no longer than sweep_step_, so no
-// point of the cloud can slip between two checked poses. Stops at the last legal sub-step.
-VirtualTool::Sweep VirtualTool::sweep(const Eigen::Vector3d& to, Eigen::Vector3d& reached, int& steps) const {
-  reached = tip_;
-  steps = 0;
-  const Eigen::Vector3d move = to - tip_;
-  const double length = move.norm();
-  if (length == 0.0) {
-    return Sweep::Legal;
-  }
-  const double needed = std::ceil(length / sweep_step_);
-  const int count = needed > kMaxSweepSteps ? kMaxSweepSteps : static_cast<int>(needed);
-  for (int i = 1; i <= count; ++i) {
-    // The last of `needed` steps lands exactly on `to`; a limited sweep stops at count full steps.
-    const Eigen::Vector3d at = (needed <= kMaxSweepSteps && i == count)
-                                   ? to
-                                   : Eigen::Vector3d(tip_ + (static_cast<double>(i) * sweep_step_ / length) * move);
-    ++steps;
-    switch (legal(at)) {
-      case Legality::Legal:
-        reached = at;
-        break;
-      case Legality::Illegal:
-        return Sweep::Illegal;
-      case Legality::Fault:
-        return Sweep::Fault;
-    }
-  }
-  return needed > kMaxSweepSteps ? Sweep::Limited : Sweep::Legal;
 }
 
 RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
@@ -97,24 +57,23 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
     result.status = RemediationStatus::Stuck;
     return result;
   }
-  Eigen::Vector3d reached;
-  int steps = 0;
-  const Sweep sweep_result = sweep(candidate, reached, steps);
-  result.sweep_steps = steps;
-  switch (sweep_result) {
-    case Sweep::Fault:
+  const SweepResult sweep = check_sweep(part_, tip_, candidate, sweep_step_, kMaxSweepSteps);
+  const Eigen::Vector3d reached = sweep.reached_mm;
+  result.sweep_steps = sweep.steps;
+  switch (sweep.status) {
+    case SweepStatus::Fault:
       result.status = RemediationStatus::Fault;
       return result;
-    case Sweep::Illegal:
+    case SweepStatus::Illegal:
       // The straight path is blocked (a thin wall between here and there): go up to it, never through.
       result.status = reached == tip_ ? RemediationStatus::Stuck : RemediationStatus::Blocked;
       tip_ = reached;
       break;
-    case Sweep::Limited:
+    case SweepStatus::Limited:
       tip_ = reached;
       result.status = RemediationStatus::SweepLimited;
       break;
-    case Sweep::Legal:
+    case SweepStatus::Legal:
       tip_ = reached;
       result.status = (result.slip_iterations > 0 || clamped) ? RemediationStatus::Slipped : RemediationStatus::Followed;
       break;

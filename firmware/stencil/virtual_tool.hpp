@@ -55,11 +55,7 @@ class VirtualTool {
   [[nodiscard]] double sweep_step_mm() const { return sweep_step_; }
 
  private:
-  enum class Sweep : std::uint8_t { Legal, Illegal, Limited, Fault };
-  [[nodiscard]] bool inside_box(const Eigen::Vector3d& tip) const;
   [[nodiscard]] Eigen::Vector3d clamp_to_box(const Eigen::Vector3d& tip) const;
-  [[nodiscard]] Legality legal(const Eigen::Vector3d& tip) const;
-  Sweep sweep(const Eigen::Vector3d& to, Eigen::Vector3d& reached, int& steps) const;
 
   const tables::PartTables& part_;
   Eigen::Vector3d tip_;
