@@ -14,13 +14,33 @@ VirtualTool::VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& 
       box_high_(part.header.workspace_mm[0], part.header.workspace_mm[1], part.header.workspace_mm[2]),
       sweep_step_(engine::sweep_step_mm(part)) {}
 
+void VirtualTool::limit_speed(double max_axis_move_mm, double max_total_move_mm) {
+  max_axis_move_ = max_axis_move_mm;
+  max_total_move_ = max_total_move_mm;
+}
+
+Eigen::Vector3d VirtualTool::within_speed(const Eigen::Vector3d& to, bool& limited) const {
+  const Eigen::Vector3d move = to - tip_;
+  const double largest = move.cwiseAbs().maxCoeff();
+  const double total = move.cwiseAbs().sum();
+  double scale = 1.0;
+  if (largest > max_axis_move_) {
+    scale = max_axis_move_ / largest;
+  }
+  if (total * scale > max_total_move_) {
+    scale = max_total_move_ / total;
+  }
+  limited = scale < 1.0;
+  return limited ? Eigen::Vector3d(tip_ + scale * move) : to;
+}
+
 Eigen::Vector3d VirtualTool::clamp_to_box(const Eigen::Vector3d& tip) const {
   return tip.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(box_high_);
 }
 
 RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
                                     const ContactParameters& parameters) {
-  RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0};
+  RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0, false};
   if (!desired_tip_mm.allFinite()) {
     result.status = RemediationStatus::Fault;
     return result;
@@ -58,7 +78,8 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
     return result;
   }
   const SweepResult sweep = check_sweep(part_, tip_, candidate, sweep_step_, kMaxSweepSteps);
-  const Eigen::Vector3d reached = sweep.reached_mm;
+  // Every point between the tip and `reached` was checked, so a shorter move along it is legal too.
+  const Eigen::Vector3d reached = within_speed(sweep.reached_mm, result.speed_limited);
   result.sweep_steps = sweep.steps;
   switch (sweep.status) {
     case SweepStatus::Fault:

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -29,6 +30,7 @@ struct RemediationResult {
   Eigen::Vector3d tip_mm;     // the virtual tool's tip after this cycle (axis is +z)
   int slip_iterations;
   int sweep_steps;
+  bool speed_limited;         // the tool went only part of the way: as fast as the mill can follow
 };
 
 // The virtual tool of a 3-axis mill: the axis is always +z; only the tip moves. Legal means no
@@ -49,6 +51,11 @@ class VirtualTool {
                 parameters);
   }
 
+  // The most the tip may move in one step: per axis, and all axes together (|dx| + |dy| + |dz|), so
+  // the mill can follow (motion::limit_tool_move gives the figures). Unlimited until set. The cut
+  // move keeps its direction and stays on the checked sweep, so it is legal.
+  void limit_speed(double max_axis_move_mm, double max_total_move_mm);
+
   [[nodiscard]] const Eigen::Vector3d& tip_mm() const { return tip_; }
   [[nodiscard]] ToolPose pose() const { return {tip_, Eigen::Vector3d::UnitZ()}; }
   // Longest sub-step of a sweep: half the tables' achieved point spacing.
@@ -56,11 +63,14 @@ class VirtualTool {
 
  private:
   [[nodiscard]] Eigen::Vector3d clamp_to_box(const Eigen::Vector3d& tip) const;
+  [[nodiscard]] Eigen::Vector3d within_speed(const Eigen::Vector3d& to, bool& limited) const;
 
   const tables::PartTables& part_;
   Eigen::Vector3d tip_;
   Eigen::Vector3d box_high_;
   double sweep_step_;
+  double max_axis_move_ = std::numeric_limits<double>::infinity();
+  double max_total_move_ = std::numeric_limits<double>::infinity();
 };
 
 }  // namespace stencil::engine

@@ -1,0 +1,333 @@
+// The machine side: frames, the virtual tool's speed limit, and the waypoint planner against the
+// hex prism, with the mill's staircase checked independently at a fine pitch and a deadband model
+// of backlash standing in for the real screws.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <vector>
+
+#include "firmware/motion/machine_frames.hpp"
+#include "firmware/motion/machine_planner.hpp"
+#include "firmware/motion/speed_limit.hpp"
+#include "firmware/stencil/sweep.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/support/gouge_oracle.hpp"
+#include "tests/support/sample_tables.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::motion;
+
+namespace {
+
+const Eigen::Vector3d kHome(25.0, 12.5, 20.0);  // above the prism
+
+MachineFrames sherline_frames() { return {10.0, Eigen::Vector3d::Zero(), kHome, {-1, -1, 1}, 640.0}; }
+
+PlannerLimits sherline_limits() { return {{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}}; }
+
+constexpr std::int32_t kAxisBudget = 29;   // floor(1.4 mm/s * 640 steps/mm / 30 Hz)
+constexpr std::int32_t kTotalBudget = 33;  // floor(1000 steps/s / 30 Hz)
+
+struct Loaded {
+  tablegen::TableBytes bytes;
+  tables::PartTables part{};
+  Loaded() : bytes(test::make_table(test::default_part(), test::default_job_options(2))) {
+    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+  }
+};
+
+
+// The mill's own screws: an axis follows its motor only once the slack on that side is taken up.
+struct DeadbandAxis {
+  double motor = 0.0;
+  double axis = 0.0;
+  double backlash = 0.0;
+  void move_motor_to(double target) {
+    motor = target;
+    axis = std::clamp(axis, motor - backlash, motor);  // pushed from either side of the gap
+  }
+};
+
+// Every point of the staircase the mill follows from `from` to `to` in `order`, checked every 2 um
+// by the engine and by the exact triangle oracle.
+void check_staircase(const tables::PartTables& part, const MachineFrames& frames, const MachineSteps& from,
+                     const MachineSteps& to, const AxisOrder& order) {
+  MachineSteps corner = from;
+  for (const std::uint8_t axis : order) {
+    const std::int32_t start = corner.axis[axis];
+    const std::int32_t end = to.axis[axis];
+    const std::int32_t direction = end > start ? 1 : -1;
+    for (std::int32_t s = start; s != end + direction && start != end; s += direction) {
+      corner.axis[axis] = s;
+      const Eigen::Vector3d at = steps_to_world(frames, corner);
+      CHECK(engine::check_tip_legal(part, at) == engine::Legality::Legal);
+      CHECK(test::ball_end_gouge_mm(part, at) <= part.header.gouge_bound_mm + 1e-5);
+    }
+    corner.axis[axis] = end;
+  }
+}
+
+struct Run {
+  std::vector<PlanResult> updates;
+  std::vector<MachineSteps> axis_before;
+};
+
+// Drives the planner at 30 Hz from a virtual tool fed at 1 kHz: every update's limits and staircase
+// are checked; the link completes each target before the next update.
+Run drive(MachinePlanner& planner, const tables::PartTables& part, const std::vector<Eigen::Vector3d>& virtual_path,
+          int extra_updates) {
+  const MachineFrames frames = sherline_frames();
+  Run run;
+  const auto update = [&]() {
+    const MachineSteps before = planner.axis_steps();
+    const MachineSteps motor_before = planner.motor_steps();
+    const PlanResult r = planner.plan(1);
+    CHECK(r.status != PlanStatus::Fault);
+    std::int32_t total = 0;
+    for (std::size_t i = 0; i < 3; ++i) {
+      const std::int32_t motor_move = std::abs(r.motor_target.axis[i] - motor_before.axis[i]);
+      CHECK(motor_move <= kAxisBudget);
+      total += motor_move;
+    }
+    CHECK(total <= kTotalBudget);
+    CHECK_EQUAL(total, r.motor_steps);
+    if (r.status == PlanStatus::Moved) {
+      check_staircase(part, frames, before, r.axis_target, r.order);
+    } else {
+      CHECK(r.axis_target == before);  // nothing but a move moves the tool
+    }
+    run.updates.push_back(r);
+    run.axis_before.push_back(before);
+  };
+  for (std::size_t i = 0; i < virtual_path.size(); ++i) {
+    CHECK(planner.follow(virtual_path[i]) != PathStatus::Full);
+    if (i % 33 == 32) {
+      update();
+    }
+  }
+  for (int i = 0; i < extra_updates; ++i) {
+    update();
+  }
+  return run;
+}
+
+// The virtual tool's path at the mill's speed from `from` through `waypoints`, remediated by the
+// engine (so it hugs the part where a waypoint is inside it).
+std::vector<Eigen::Vector3d> virtual_path(const tables::PartTables& part, const Eigen::Vector3d& from,
+                                          const std::vector<Eigen::Vector3d>& waypoints, double speed_fraction) {
+  const MachineSpeed speed{1.4 * speed_fraction, 1000.0 * speed_fraction, 640.0};
+  engine::VirtualTool tool(part, from);
+  tool.limit_speed(speed.max_axis_speed_mm_per_s * 0.001, speed.step_rate_steps_per_s / speed.steps_per_mm * 0.001);
+  std::vector<Eigen::Vector3d> path;
+  for (const Eigen::Vector3d& waypoint : waypoints) {
+    // Long enough to get there at this speed, or to come to rest against the part.
+    const int cycles = static_cast<int>((waypoint - tool.tip_mm()).cwiseAbs().sum() / (speed.max_axis_speed_mm_per_s * 0.001)) + 200;
+    for (int cycle = 0; cycle < cycles; ++cycle) {
+      const Eigen::Vector3d desired = limit_tool_move(speed, tool.tip_mm(), waypoint, 0.001);
+      const engine::RemediationResult result = tool.step(desired, engine::ContactParameters{});
+      CHECK(result.status != engine::RemediationStatus::Fault);
+      path.push_back(tool.tip_mm());
+      if ((tool.tip_mm() - waypoint).norm() < 1e-9) {
+        break;
+      }
+    }
+  }
+  return path;
+}
+
+}  // namespace
+
+TEST_GROUP(MachineFrames){};
+
+TEST(MachineFrames, TheSherlinesTableAxesCountAgainstTheWorldAndStepsRoundTrip) {
+  const MachineFrames frames = sherline_frames();
+  MachineSteps steps{};
+  CHECK(world_to_steps(frames, kHome + Eigen::Vector3d(1.0, 0.5, -2.0), steps));
+  CHECK_EQUAL(-640, steps.axis[0]);  // the tool goes +x: the table goes -x
+  CHECK_EQUAL(-320, steps.axis[1]);
+  CHECK_EQUAL(-1280, steps.axis[2]);
+  const Eigen::Vector3d back = steps_to_world(frames, steps);
+  CHECK((back - (kHome + Eigen::Vector3d(1.0, 0.5, -2.0))).norm() < 1e-12);
+  CHECK(world_to_steps(frames, kHome + Eigen::Vector3d(0.0007, -0.0008, 0.0), steps));  // nearest step
+  CHECK_EQUAL(0, steps.axis[0]);
+  CHECK_EQUAL(1, steps.axis[1]);
+  CHECK_FALSE(world_to_steps(frames, Eigen::Vector3d(NAN, 0.0, 0.0), steps));
+  CHECK_FALSE(world_to_steps(frames, Eigen::Vector3d(1e5, 0.0, 0.0), steps));  // beyond 24 bits of steps
+  const Eigen::Vector3d world = device_to_world(frames, Eigen::Vector3d(250.0, 125.0, 200.0));
+  CHECK((world - Eigen::Vector3d(25.0, 12.5, 20.0)).norm() < 1e-12);
+  CHECK((world_to_device(frames, world) - Eigen::Vector3d(250.0, 125.0, 200.0)).norm() < 1e-12);
+}
+
+TEST_GROUP(SpeedLimit){};
+
+TEST(SpeedLimit, NoAxisFasterThanTheMillAndAllAxesTogetherWithinTheStepRate) {
+  const MachineSpeed speed{1.4, 1000.0, 640.0};
+  const Eigen::Vector3d along_x = limit_tool_move(speed, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0), 0.001);
+  DOUBLES_EQUAL(0.0014, along_x.x(), 1e-15);
+  const Eigen::Vector3d diagonal = limit_tool_move(speed, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 1, 1), 0.001);
+  DOUBLES_EQUAL(1000.0 / 640.0 * 0.001, diagonal.cwiseAbs().sum(), 1e-15);  // the step rate binds
+  DOUBLES_EQUAL(diagonal.x(), diagonal.z(), 1e-18);                          // direction kept
+  const Eigen::Vector3d slow(0.0001, 0.0, -0.0002);
+  CHECK(limit_tool_move(speed, Eigen::Vector3d::Zero(), slow, 0.001) == slow);
+  CHECK(limit_tool_move(speed, Eigen::Vector3d::Ones(), Eigen::Vector3d(NAN, 0, 0), 0.001) == Eigen::Vector3d::Ones());
+}
+
+TEST_GROUP(MachinePlanner){};
+
+TEST(MachinePlanner, NothingIsCommandedBeforeHoming) {
+  const Loaded loaded;
+  MachinePlanner planner(loaded.part, sherline_frames(), sherline_limits());
+  CHECK(planner.plan(0).status == PlanStatus::NotHomed);
+}
+
+TEST(MachinePlanner, FollowsAFreePathWithinTheMillsSpeedAndEndsExactlyOnIt) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  planner.homed({{0, 0, 0}}, {1, 1, 1});
+  const Eigen::Vector3d end = kHome + Eigen::Vector3d(1.2, -0.7, 0.9);  // +x, -y, +z: x and z need no take-up
+  const std::vector<Eigen::Vector3d> path = virtual_path(part, kHome, {end}, 0.9);
+  const Run run = drive(planner, part, path, 60);
+  MachineSteps expected{};
+  CHECK(world_to_steps(sherline_frames(), end, expected));
+  CHECK(planner.axis_steps() == expected);
+  CHECK(run.updates.back().status == PlanStatus::AtGoal);
+  double worst_lag = 0.0;
+  for (const PlanResult& r : run.updates) {
+    worst_lag = std::max(worst_lag, r.lag_mm);
+  }
+  CHECK(worst_lag < 0.25);  // a few updates of motion at most
+}
+
+TEST(MachinePlanner, BacklashIsTakenUpOnEveryReversalSoTheToolIsWhereItWasCommanded) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  const PlannerLimits limits = sherline_limits();
+  MachinePlanner planner(part, sherline_frames(), limits);
+  planner.homed({{0, 0, 0}}, {-1, -1, -1});  // homed moving down: every slack on the minus side
+  std::array<DeadbandAxis, 3> mill;
+  for (std::size_t i = 0; i < 3; ++i) {
+    mill[i].backlash = limits.backlash_steps[i];
+    mill[i].motor = 0.0;  // the motor pushed the axis down to here: no gap below it
+    mill[i].axis = 0.0;
+  }
+  const std::array<double, 3> axis_zero = {mill[0].axis, mill[1].axis, mill[2].axis};
+  // Up, back down, up again on every axis: three reversals each after the first move.
+  const std::vector<Eigen::Vector3d> corners = {kHome + Eigen::Vector3d(0.4, 0.3, 0.5), kHome,
+                                                kHome + Eigen::Vector3d(-0.3, 0.2, 0.4),
+                                                kHome + Eigen::Vector3d(0.2, -0.1, 0.1)};
+  const std::vector<Eigen::Vector3d> path = virtual_path(part, kHome, corners, 0.9);
+  int take_ups = 0;
+  std::int32_t take_up_steps = 0;
+  const MachineFrames frames = sherline_frames();
+  for (std::size_t i = 0; i <= path.size() + 33 * 200; ++i) {
+    if (i < path.size()) {
+      CHECK(planner.follow(path[i]) != PathStatus::Full);
+    }
+    if (i % 33 != 32) {
+      continue;
+    }
+    const PlanResult r = planner.plan(1);
+    for (std::size_t a = 0; a < 3; ++a) {
+      mill[a].move_motor_to(r.motor_target.axis[a]);
+    }
+    if (r.status == PlanStatus::TakingUp) {
+      ++take_ups;
+      take_up_steps += r.motor_steps;
+    }
+    // The true axis is exactly where the planner says the tool is, after every update.
+    for (std::size_t a = 0; a < 3; ++a) {
+      if (r.status != PlanStatus::TakingUp) {
+        DOUBLES_EQUAL(static_cast<double>(r.axis_target.axis[a]), mill[a].axis - axis_zero[a], 0.0);
+      }
+    }
+  }
+  MachineSteps expected{};
+  CHECK(world_to_steps(frames, corners.back(), expected));
+  CHECK(planner.axis_steps() == expected);
+  CHECK(take_ups > 0);
+  // Reversals in machine steps (x and y count against the world), slack first on the minus side:
+  // x world +,-,-,+ = steps -,+,+,- : 2; y world +,-,+,- = steps -,+,-,+ : 3; z +,-,+,- : 4.
+  CHECK_EQUAL(2 * 80 + 3 * 32 + 4 * 80, take_up_steps);
+}
+
+TEST(MachinePlanner, AroundAConvexCornerOfTheHexPrismTheMillNeverCutsTheCornerAndKeepsUp) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  // Start beside the prism's vertex at (33, 12.5), low enough that the cutter's side meets the
+  // walls, then ask for points inside the prism on either side of the vertex: the virtual tool
+  // slides along one wall, round the vertex, along the other.
+  const Eigen::Vector3d start(33.0, 12.5 - 3.0, 2.0);
+  const Eigen::Vector3d after(33.0 - 2.0, 12.5 + 4.0, 2.0);
+  const MachineFrames frames = sherline_frames();
+  MachineSteps start_steps{};
+  CHECK(world_to_steps(frames, start, start_steps));
+  CHECK(engine::check_tip_legal(part, steps_to_world(frames, start_steps)) == engine::Legality::Legal);
+  planner.homed(start_steps, {1, 1, 1});
+  const std::vector<Eigen::Vector3d> path =
+      virtual_path(part, steps_to_world(frames, start_steps), {Eigen::Vector3d(31.5, 12.5, 2.0), after}, 0.8);
+  // The straight way between the two sides goes through the prism: there is a corner to cut.
+  const engine::SweepResult shortcut =
+      engine::check_sweep(part, path.front(), path.back(), engine::sweep_step_mm(part), 100000);
+  CHECK(shortcut.status == engine::SweepStatus::Illegal);
+  const Run run = drive(planner, part, path, 200);
+  // Every staircase was checked in drive(); the mill also got round.
+  const Eigen::Vector3d reached = steps_to_world(frames, planner.axis_steps());
+  CHECK((reached - path.back()).norm() < 0.01);
+  int blocked = 0;
+  int take_ups = 0;
+  double worst_lag = 0.0;
+  for (const PlanResult& r : run.updates) {
+    blocked += r.status == PlanStatus::Blocked ? 1 : 0;
+    take_ups += r.status == PlanStatus::TakingUp ? 1 : 0;
+    worst_lag = std::max(worst_lag, r.lag_mm);
+  }
+  // The virtual tool trembles against the walls (tens of reversals, each a backlash take-up of up
+  // to 2.4 updates), so the mill falls behind by a few tenths at worst and then catches up.
+  CHECK(worst_lag < 0.5);
+  CHECK(blocked < 20);
+  std::printf("\n  hex prism corner, virtual tool at 80%% of the mill's speed: %zu updates, %d taking up backlash, "
+              "%d blocked, worst lag %.3f mm\n",
+              run.updates.size(), take_ups, blocked, worst_lag);
+}
+
+TEST(MachinePlanner, NeverCommandsBelowTheStockFloorOrOutsideTheTravelWhateverItIsHanded) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  const Eigen::Vector3d corner(1.0, 1.0, 0.01);
+  MachineSteps at{};
+  CHECK(world_to_steps(sherline_frames(), corner, at));
+  planner.homed(at, {-1, -1, -1});
+  CHECK(planner.follow(corner + Eigen::Vector3d(-0.02, -0.02, -0.03)) == PathStatus::Added);
+  for (int i = 0; i < 20; ++i) {
+    // It may edge towards the point, but only as far as the floor and the travel allow.
+    const PlanResult r = planner.plan(1);
+    CHECK(r.status != PlanStatus::Fault);
+    CHECK((steps_to_world(sherline_frames(), r.axis_target).array() >= 0.0).all());
+  }
+  CHECK(planner.path_size() == 1);  // never reached
+  CHECK(planner.follow(Eigen::Vector3d(NAN, 1.0, 1.0)) == PathStatus::Invalid);
+}
+
+TEST(MachinePlanner, TheQueueHoldsAtMostTwoUpdates) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  planner.homed({{0, 0, 0}}, {1, 1, 1});
+  for (int i = 1; i <= 100; ++i) {
+    CHECK(planner.follow(kHome + Eigen::Vector3d(0.0, 0.0, 0.002 * i)) == PathStatus::Added);
+  }
+  CHECK(planner.plan(0).status == PlanStatus::Moved);
+  CHECK(planner.plan(0).status == PlanStatus::Moved);
+  CHECK(planner.plan(0).status == PlanStatus::Waiting);
+  CHECK_EQUAL(2, planner.queued());
+  CHECK(planner.plan(1).status == PlanStatus::Moved);
+}
