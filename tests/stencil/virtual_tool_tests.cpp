@@ -115,6 +115,25 @@ TEST(VirtualTool, SlipsAlongAFaceInsteadOfStickingAtTheEntryPoint) {
   CHECK(tool.tip_mm().z() <= 6.0 + 0.01);
 }
 
+TEST(VirtualTool, WithASpeedLimitItMovesNoFasterThanTheMillAndStaysLegal) {
+  const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
+  VirtualTool tool(loaded.part, {20.0, 12.5, 7.0});
+  tool.limit_speed(0.0014, 0.0015);  // per cycle: 1.4 mm/s per axis, 1.5 mm/s all axes together
+  int limited = 0;
+  // Far, fast, and into the part: the tool creeps along at the limit, slips included.
+  for (int i = 0; i < 3000; ++i) {
+    const Eigen::Vector3d before = tool.tip_mm();
+    const RemediationResult result = tool.step({30.0, 14.0, 5.0}, ContactParameters{});
+    const Eigen::Vector3d move = (tool.tip_mm() - before).cwiseAbs();
+    CHECK(move.maxCoeff() <= 0.0014 + 1e-15);
+    CHECK(move.sum() <= 0.0015 + 1e-15);
+    CHECK(check_legal(loaded.part, tool.pose()) == Legality::Legal);
+    limited += result.speed_limited ? 1 : 0;
+  }
+  CHECK(limited > 2000);
+  CHECK(tool.tip_mm().x() > 22.0);  // and it did get somewhere
+}
+
 TEST(VirtualTool, NeverGoesBelowTheFloorOrOutOfTheWorkspace) {
   const Loaded loaded(tablegen::thin_fin(20.0, 0.6, 8.0, 15.0, 12.2));
   VirtualTool tool(loaded.part, {5.0, 5.0, 5.0});
