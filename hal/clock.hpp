@@ -14,7 +14,6 @@ class Clock {
   Clock() = default;
   Clock(const Clock&) = delete;
   Clock& operator=(const Clock&) = delete;
-  virtual ~Clock() = default;
 
   // Now. Real-time safe: no allocation, no lock, no blocking.
   [[nodiscard]] virtual MonotonicNs now_ns() const = 0;
@@ -23,6 +22,11 @@ class Clock {
   // clock_nanosleep on CLOCK_MONOTONIC, retried on EINTR; a virtual clock jumps to the deadline.
   // The only blocking call the cycle makes.
   virtual void sleep_until_ns(MonotonicNs deadline_ns) = 0;
+
+ protected:
+  // Not virtual, and not public: clocks are made by the board (statically) and never deleted
+  // through this interface; a virtual destructor would pull operator delete into the core.
+  ~Clock() = default;
 };
 
 }  // namespace stencil::hal
