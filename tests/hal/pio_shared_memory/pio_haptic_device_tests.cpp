@@ -16,11 +16,14 @@
 #include "sim/haptic_device/simulated_haptic_device.hpp"
 #include "tests/hal/pio_shared_memory/haptic_result_strings.hpp"
 #include "tests/hal/pio_shared_memory/window_pair.hpp"
+#include "tests/sim/haptic_device/counter_pose.hpp"
 
 #include <CppUTest/TestHarness.h>
 
 using namespace stencil;
 using hal::HapticFault;
+using test::consistent_with_counter;
+using test::counter_pose;
 using hal::ReadStatus;
 using hal::WriteStatus;
 namespace pio = hal::pio_shared_memory;
@@ -28,24 +31,6 @@ namespace pio = hal::pio_shared_memory;
 namespace {
 
 constexpr hal::MonotonicNs kMs = 1'000'000;
-
-// Every field of sample k follows from k, so a sample mixed from two writes cannot pass the check.
-sim::SimulatedPose counter_pose(std::uint32_t k, hal::MonotonicNs) {
-  const double cycle = static_cast<double>(k % 2000U);
-  return {{cycle * 0.1 - 100.0, -cycle * 0.05, cycle * 0.025}, {cycle * 1e-3 - 1.0, 1.0 - cycle * 5e-4}};
-}
-
-bool consistent_with_counter(const hal::HapticSample& sample) {
-  const sim::SimulatedPose expected = counter_pose(sample.sample_counter, 0);
-  for (int axis = 0; axis < 3; ++axis) {
-    if (std::fabs(sample.position_mm[axis] - expected.position_mm[axis]) > 1e-6) return false;
-  }
-  for (int angle = 0; angle < 2; ++angle) {
-    if (std::fabs(sample.angles_rad[angle] - expected.angles_rad[angle]) > 1e-6) return false;
-  }
-  // The simulated device beats once per sample, from the same start.
-  return sample.device_heartbeat == sample.sample_counter;
-}
 
 hal::HapticSample marker_sample() {
   hal::HapticSample sample{};
