@@ -1,0 +1,137 @@
+// The host's side of the haptic CAN exchange: drain, pair and check the device's frames; clamp,
+// encode and send the command; watch the device heartbeat.
+#include "hal/socketcan/socketcan_haptic_device.hpp"
+
+#include <algorithm>
+
+#include "hal/pio_shared_memory/haptic_range_checks.hpp"
+
+namespace stencil::hal::socketcan {
+
+SocketCanHapticDevice::SocketCanHapticDevice(CanChannel* channel, const HapticRange& range,
+                                             MonotonicNs device_watchdog_ns)
+    : channel_(channel),
+      range_(range),
+      assembler_(range),
+      device_watchdog_(device_watchdog_ns),
+      state_(channel == nullptr ? HapticLinkState::Closed : HapticLinkState::WaitingForDevice) {}
+
+HapticCounters SocketCanHapticDevice::counters() const {
+  HapticCounters counters = counters_;
+  counters.bad_frames = assembler_.rejections().total();
+  counters.samples_out_of_range = assembler_.rejections().of(FrameRejection::OutOfRange);
+  return counters;
+}
+
+ReadResult SocketCanHapticDevice::read_fault(HapticFault reason) {
+  if (latched_fault_ == HapticFault::None) latched_fault_ = reason;
+  return {ReadStatus::Fault, reason};
+}
+
+WriteResult SocketCanHapticDevice::write_fault(HapticFault reason) {
+  if (latched_fault_ == HapticFault::None) latched_fault_ = reason;
+  return {WriteStatus::Fault, reason};
+}
+
+ReadResult SocketCanHapticDevice::read_sample(MonotonicNs now_ns, HapticSample& out) {
+  if (channel_ == nullptr) return read_fault(HapticFault::NotOpen);
+
+  bool new_pose = false;
+  FrameRejection refused = FrameRejection::None;
+  for (int frame_index = 0; frame_index < kMaxFramesPerRead; ++frame_index) {
+    can_frame frame;
+    const TransferStatus received = channel_->receive(frame);
+    if (received == TransferStatus::WouldBlock) break;
+    if (received == TransferStatus::WrongSize) {
+      assembler_.count(FrameRejection::WrongSize);
+      refused = FrameRejection::WrongSize;
+      continue;
+    }
+    if (received != TransferStatus::Done) {
+      ++counters_.transport_errors;
+      state_ = HapticLinkState::Disconnected;
+      return read_fault(HapticFault::TransportError);
+    }
+    const FrameResult result = assembler_.accept(frame);
+    if (result.effect == FrameEffect::Completed) new_pose = true;
+    if (result.effect == FrameEffect::Rejected) refused = result.rejection;
+  }
+
+  // The device heartbeat comes with the Status frame; none yet counts as a heartbeat that never moved.
+  const std::uint32_t heartbeat = assembler_.has_status() ? assembler_.latest_status().device_heartbeat : 0U;
+  if (!device_watchdog_.observe(heartbeat, now_ns)) {
+    state_ = HapticLinkState::Disconnected;
+    return read_fault(HapticFault::DeviceHeartbeatLost);
+  }
+  if (assembler_.has_status()) state_ = HapticLinkState::Connected;
+
+  if (!new_pose) {
+    if (refused != FrameRejection::None) {
+      return {ReadStatus::Rejected,
+              refused == FrameRejection::OutOfRange ? HapticFault::SampleOutOfRange : HapticFault::BadFrame};
+    }
+    ++counters_.stale_reads;
+    return {ReadStatus::Stale, HapticFault::None};
+  }
+
+  const PoseWire& pose = assembler_.latest_pose();
+  // Extend the 8-bit wire counter: frames arrive in order, so the difference mod 256 is the advance.
+  if (seen_a_pose_) {
+    sample_counter_ += static_cast<std::uint8_t>(pose.counter - static_cast<std::uint8_t>(sample_counter_));
+  } else {
+    sample_counter_ = pose.counter;
+    seen_a_pose_ = true;
+  }
+  HapticSample sample;
+  for (int axis = 0; axis < 3; ++axis) sample.position_mm[axis] = pose.position_um[axis] * 1e-3;
+  for (int angle = 0; angle < 2; ++angle) sample.angles_rad[angle] = pose.angles_100urad[angle] * kAngleRadPerUnit;
+  sample.sample_counter = sample_counter_;
+  sample.status_bits = assembler_.latest_status().status_bits;
+  sample.device_heartbeat = heartbeat;
+  out = sample;
+  ++counters_.samples_accepted;
+  return {ReadStatus::Fresh, HapticFault::None};
+}
+
+WriteResult SocketCanHapticDevice::write_command(const HapticCommand& command) {
+  if (channel_ == nullptr) return write_fault(HapticFault::NotOpen);
+  // Never more than the device accepts, whatever the range says.
+  const double force_limit_n = std::min(range_.force_limit_n, kForceLimitMn * 1e-3);
+  const double torque_limit_nmm = std::min(range_.torque_limit_nmm, kTorqueLimitUnits * kTorqueNmmPerUnit);
+  const pio_shared_memory::ClampedCommand clamped =
+      pio_shared_memory::clamp_command(command, force_limit_n, torque_limit_nmm);
+
+  CommandWire wire{};
+  wire.counter = static_cast<std::uint8_t>(command.cycle_counter & 0xFFU);
+  for (int axis = 0; axis < 3; ++axis) {
+    wire.force_mn[axis] = static_cast<std::int16_t>(pio_shared_memory::to_units_toward_zero(clamped.force_n[axis], 1e3));
+  }
+  for (int axis = 0; axis < 2; ++axis) {
+    wire.torque_10mnmm[axis] = static_cast<std::int16_t>(
+        pio_shared_memory::to_units_toward_zero(clamped.torque_nmm[axis], 1.0 / kTorqueNmmPerUnit));
+  }
+  wire.enable = clamped.finite && command.enable;
+  wire.host_heartbeat = ++host_heartbeat_;
+
+  can_frame force_frame;
+  can_frame torque_frame;
+  encode_command(wire, force_frame, torque_frame);
+  for (const can_frame* frame : {&force_frame, &torque_frame}) {
+    const TransferStatus sent = channel_->send(*frame);
+    if (sent == TransferStatus::Done) continue;
+    ++counters_.transport_errors;
+    return write_fault(sent == TransferStatus::WouldBlock ? HapticFault::TransportFull : HapticFault::TransportError);
+  }
+
+  if (!clamped.finite) {
+    ++counters_.commands_rejected;
+    return {WriteStatus::Rejected, HapticFault::CommandNotFinite};
+  }
+  if (clamped.clamped) {
+    ++counters_.commands_clamped;
+    return {WriteStatus::Clamped, HapticFault::None};
+  }
+  return {WriteStatus::Written, HapticFault::None};
+}
+
+}  // namespace stencil::hal::socketcan

@@ -1,0 +1,406 @@
+// The PIO shared memory backend: the window's header check, seqlock reads that never accept a torn
+// sample, stale and frozen devices, range rules on both sides, and the time of one cycle.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <thread>
+#include <vector>
+
+#include "hal/pio_shared_memory/pio_device_side.hpp"
+#include "hal/pio_shared_memory/pio_haptic_device.hpp"
+#include "hal/pio_shared_memory/seqlock.hpp"
+#include "sim/haptic_device/pio_device_link.hpp"
+#include "sim/haptic_device/simulated_device_thread.hpp"
+#include "sim/haptic_device/simulated_haptic_device.hpp"
+#include "tests/hal/pio_shared_memory/haptic_result_strings.hpp"
+#include "tests/hal/pio_shared_memory/window_pair.hpp"
+#include "tests/sim/haptic_device/counter_pose.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using hal::HapticFault;
+using test::consistent_with_counter;
+using test::counter_pose;
+using hal::ReadStatus;
+using hal::WriteStatus;
+namespace pio = hal::pio_shared_memory;
+
+namespace {
+
+constexpr hal::MonotonicNs kMs = 1'000'000;
+
+hal::HapticSample marker_sample() {
+  hal::HapticSample sample{};
+  sample.position_mm[0] = 12345.0;
+  sample.sample_counter = 0xDEADU;
+  return sample;
+}
+
+hal::HapticCommand command_of(double fx, double fy, double fz, bool enable = true) {
+  return hal::HapticCommand{{fx, fy, fz}, {0.0, 0.0}, 7, enable};
+}
+
+}  // namespace
+
+TEST_GROUP(PioSharedWindow) {
+  test::WindowPair windows = test::make_device_window();
+};
+
+TEST(PioSharedWindow, HostRefusesAWindowTheDeviceHasNotInitialised) {
+  CHECK_TRUE(windows.device != nullptr);
+  test::open_host_window(windows);
+  CHECK_TRUE(windows.host == nullptr);
+  STRCMP_CONTAINS("byte 0 (magic): 0x00000000, expected 0x50415448", windows.error.c_str());
+
+  sim::PioDeviceLink device_link(windows.device->window());
+  test::open_host_window(windows);
+  CHECK_TRUE(windows.host != nullptr);
+  CHECK_EQUAL(pio::kWindowMagic, windows.host->window().header.magic);
+}
+
+TEST(PioSharedWindow, HostRefusesAWindowOfAnotherLayoutVersion) {
+  sim::PioDeviceLink device_link(windows.device->window());
+  windows.device->window().header.layout_version = pio::kLayoutVersion + 1;
+  test::open_host_window(windows);
+  CHECK_TRUE(windows.host == nullptr);
+  STRCMP_CONTAINS("byte 4 (layout version): 2, expected 1", windows.error.c_str());
+}
+
+TEST(PioSharedWindow, OpeningAFileShorterThanTheWindowNamesBothSizes) {
+  std::string error;
+  CHECK_TRUE(pio::SharedWindowMapping::open("/dev/null", 0, false, error) == nullptr);
+  CHECK_TRUE(!error.empty());
+  char path[] = "/tmp/haptic-short-window-XXXXXX";
+  const int fd = ::mkstemp(path);
+  CHECK_TRUE(fd >= 0);
+  CHECK_EQUAL(0, ::ftruncate(fd, 100));
+  ::close(fd);
+  CHECK_TRUE(pio::SharedWindowMapping::open(path, 0, false, error) == nullptr);
+  ::unlink(path);
+  STRCMP_CONTAINS("100 bytes, expected at least 192", error.c_str());
+}
+
+TEST_GROUP(PioHapticDevice) {
+  test::WindowPair windows;
+  std::unique_ptr<sim::PioDeviceLink> device_link;
+  std::unique_ptr<sim::SimulatedHapticDevice> device;
+  std::unique_ptr<pio::PioHapticDevice> host;
+
+  void setup() override {
+    windows = test::make_device_window();
+    device_link = std::make_unique<sim::PioDeviceLink>(windows.device->window());
+    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, counter_pose);
+    test::open_host_window(windows);
+    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
+  }
+};
+
+TEST(PioHapticDevice, GivesEachNewSampleOnceInMillimetresAndRadians) {
+  hal::HapticSample sample = marker_sample();
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(0, sample).status);  // the device has not written yet
+  CHECK_EQUAL(hal::HapticLinkState::WaitingForDevice, host->link_state());
+  DOUBLES_EQUAL(12345.0, sample.position_mm[0], 0.0);
+
+  device->step(1 * kMs);
+  const hal::ReadResult first = host->read_sample(1 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fresh, first.status);
+  CHECK_EQUAL(HapticFault::None, first.reason);
+  CHECK_EQUAL(1U, sample.sample_counter);
+  DOUBLES_EQUAL(-99.9, sample.position_mm[0], 1e-9);
+  DOUBLES_EQUAL(-0.05, sample.position_mm[1], 1e-9);
+  DOUBLES_EQUAL(0.025, sample.position_mm[2], 1e-9);
+  DOUBLES_EQUAL(-0.999, sample.angles_rad[0], 1e-9);
+  DOUBLES_EQUAL(0.9995, sample.angles_rad[1], 1e-9);
+  CHECK_EQUAL(1U, sample.device_heartbeat);
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
+
+  sample = marker_sample();
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(1 * kMs, sample).status);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);  // untouched
+  device->step(2 * kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(2 * kMs, sample).status);
+  CHECK_EQUAL(2U, sample.sample_counter);
+
+  const hal::HapticCounters counters = host->counters();
+  CHECK_EQUAL(2U, counters.samples_accepted);
+  CHECK_EQUAL(2U, counters.stale_reads);
+}
+
+TEST(PioHapticDevice, ReportsBusyAndKeepsTheOldSampleWhenTheDeviceIsStuckMidWrite) {
+  device->step(1 * kMs);
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
+
+  // The device starts a write (odd sequence), changes half the fields and never finishes.
+  pio::PoseBlock& pose = windows.device->window().pose;
+  std::atomic_ref<std::uint32_t>(pose.sequence).fetch_add(1);
+  pose.sample_counter = 99;
+  pose.position_um[0] = 1;
+
+  hal::HapticSample after = marker_sample();
+  const hal::ReadResult busy = host->read_sample(2 * kMs, after);
+  CHECK_EQUAL(ReadStatus::Rejected, busy.status);
+  CHECK_EQUAL(HapticFault::SampleBusy, busy.reason);
+  CHECK_EQUAL(0xDEADU, after.sample_counter);  // nothing of the half-written block reached the caller
+  CHECK_EQUAL(1U, host->counters().busy_reads);
+  CHECK_EQUAL(static_cast<std::uint64_t>(pio::kSeqlockAttempts), host->counters().torn_read_retries);
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+
+  // Still stuck past the watchdog time: a disconnect, not a busy read forever.
+  const hal::ReadResult lost = host->read_sample(1 * kMs + pio::kDefaultDeviceWatchdogNs + 1, after);
+  CHECK_EQUAL(ReadStatus::Fault, lost.status);
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, lost.reason);
+  CHECK_EQUAL(0xDEADU, after.sample_counter);
+
+  // The device recovers: its next write completes the block and the host takes it whole.
+  device->step(60 * kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(60 * kMs, after).status);
+  CHECK_EQUAL(2U, after.sample_counter);
+  CHECK_TRUE(consistent_with_counter(after));
+}
+
+TEST(PioHapticDevice, AFrozenDeviceReadsStaleThenDisconnectsAfterTheWatchdogTime) {
+  hal::HapticSample sample{};
+  for (int ms = 1; ms <= 10; ++ms) {
+    device->step(ms * kMs);
+    CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(ms * kMs, sample).status);
+  }
+  device->set_frozen(true);
+  const hal::MonotonicNs frozen_at = 10 * kMs;
+  for (hal::MonotonicNs now = frozen_at + kMs; now <= frozen_at + pio::kDefaultDeviceWatchdogNs; now += kMs) {
+    device->step(now);
+    hal::HapticSample stale = marker_sample();
+    const hal::ReadResult result = host->read_sample(now, stale);
+    CHECK_EQUAL(ReadStatus::Stale, result.status);
+    CHECK_EQUAL(0xDEADU, stale.sample_counter);
+  }
+  CHECK_EQUAL(10U, sample.device_heartbeat);  // the last heartbeat the caller saw, frozen since
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
+
+  const hal::MonotonicNs late = frozen_at + pio::kDefaultDeviceWatchdogNs + kMs;
+  const hal::ReadResult lost = host->read_sample(late, sample);
+  CHECK_EQUAL(ReadStatus::Fault, lost.status);
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, lost.reason);
+  CHECK_EQUAL(hal::HapticLinkState::Disconnected, host->link_state());
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());
+
+  // Back again: fresh samples, connected, but the latch holds until the caller clears it.
+  device->set_frozen(false);
+  device->step(late + kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(late + kMs, sample).status);
+  CHECK_EQUAL(11U, sample.sample_counter);
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());
+  host->clear_fault();
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+}
+
+TEST(PioHapticDevice, RefusesAPoseBeyondTheDevicesReach) {
+  sim::SimulatedHapticDevice far_device(*device_link, [](std::uint32_t k, hal::MonotonicNs) {
+    return k == 2 ? sim::SimulatedPose{{0.0, 150.001, 0.0}, {0.0, 0.0}} : sim::SimulatedPose{{275.0, -150.0, 150.0}, {3.2, -3.2}};
+  });
+  hal::HapticSample sample{};
+  far_device.step(1 * kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);  // exactly at the limits
+  DOUBLES_EQUAL(275.0, sample.position_mm[0], 1e-9);
+
+  far_device.step(2 * kMs);
+  const hal::ReadResult refused = host->read_sample(2 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Rejected, refused.status);
+  CHECK_EQUAL(HapticFault::SampleOutOfRange, refused.reason);
+  CHECK_EQUAL(1U, sample.sample_counter);
+  CHECK_EQUAL(1U, host->counters().samples_out_of_range);
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(2 * kMs, sample).status);  // refused once, then nothing new
+}
+
+TEST(PioHapticDevice, ClampsForceAndTorqueToTheirLimitsBeforeWriting) {
+  hal::HapticCommand command = command_of(6.0, 8.0, 0.0);  // 10 N
+  command.torque_nmm[0] = 300.0;
+  command.torque_nmm[1] = -400.0;  // 500 N.mm
+  const hal::WriteResult result = host->write_command(command);
+  CHECK_EQUAL(WriteStatus::Clamped, result.status);
+  const pio::CommandBlock& block = windows.device->window().command;
+  CHECK_EQUAL(3000, block.force_mn[0]);
+  CHECK_EQUAL(4000, block.force_mn[1]);
+  CHECK_EQUAL(0, block.force_mn[2]);
+  CHECK_EQUAL(120000, block.torque_mnmm[0]);
+  CHECK_EQUAL(-160000, block.torque_mnmm[1]);
+  CHECK_EQUAL(pio::kCommandEnableBit, block.flags);
+  CHECK_EQUAL(7U, block.cycle_counter);
+  CHECK_EQUAL(1U, host->counters().commands_clamped);
+
+  // A diagonal at the limit rounds toward zero, so the device never sees more than 5000 mN.
+  CHECK_EQUAL(WriteStatus::Clamped, host->write_command(command_of(100.0, 100.0, 100.0)).status);
+  pio::CommandWords words{};
+  pio::load_fields(windows.device->window().command, words);
+  CHECK_TRUE(pio::command_within_device_limits(words));
+
+  device->step(1 * kMs);
+  const sim::DeviceOutput output = device->output();
+  CHECK_TRUE(output.force_applied);
+  DOUBLES_EQUAL(5.0 / std::sqrt(3.0), output.force_n[0], 1e-3);
+}
+
+TEST(PioHapticDevice, SendsZeroForceWithEnableOffForANonFiniteCommand) {
+  CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(1.0, 0.0, 0.0)).status);
+  const std::uint32_t heartbeat_before = windows.device->window().command.host_heartbeat;
+  hal::HapticCommand command = command_of(1.0, std::nan(""), 0.0);
+  const hal::WriteResult result = host->write_command(command);
+  CHECK_EQUAL(WriteStatus::Rejected, result.status);
+  CHECK_EQUAL(HapticFault::CommandNotFinite, result.reason);
+  const pio::CommandBlock& block = windows.device->window().command;
+  CHECK_EQUAL(0, block.force_mn[0]);
+  CHECK_EQUAL(0U, block.flags);
+  CHECK_EQUAL(heartbeat_before + 1, block.host_heartbeat);  // still beating
+  command.force_n[1] = 0.0;
+  command.torque_nmm[0] = INFINITY;
+  CHECK_EQUAL(WriteStatus::Rejected, host->write_command(command).status);
+  CHECK_EQUAL(2U, host->counters().commands_rejected);
+}
+
+TEST(PioHapticDevice, TheDeviceRefusesACommandBeyondItsOwnLimits) {
+  // A host that skipped its clamp: 5.001 N written straight into the block.
+  pio::CommandWords words{};
+  words.force_mn[2] = 5001;
+  words.flags = pio::kCommandEnableBit;
+  words.host_heartbeat = 1;
+  pio::seqlock_write(windows.host->window().command, words);
+  device->step(1 * kMs);
+  sim::DeviceOutput output = device->output();
+  CHECK_FALSE(output.force_applied);
+  CHECK_TRUE(output.last_command_refused);
+  DOUBLES_EQUAL(0.0, output.force_n[2], 0.0);
+  CHECK_EQUAL(1U, device_link->counters().commands_out_of_range);
+
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
+  CHECK_TRUE((sample.status_bits & hal::haptic_status::kCommandRejected) != 0U);
+
+  // Unknown flag bits are refused too.
+  words.force_mn[2] = 100;
+  words.flags = 0x10U | pio::kCommandEnableBit;
+  words.host_heartbeat = 2;
+  pio::seqlock_write(windows.host->window().command, words);
+  device->step(2 * kMs);
+  CHECK_EQUAL(2U, device_link->counters().commands_out_of_range);
+  CHECK_FALSE(device->output().force_applied);
+
+  // A proper command is driven.
+  CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 2.5)).status);
+  device->step(3 * kMs);
+  output = device->output();
+  CHECK_TRUE(output.force_applied);
+  DOUBLES_EQUAL(2.5, output.force_n[2], 1e-9);
+}
+
+TEST(PioHapticDevice, TheHostHeartbeatMovesWithEveryWriteAndContinuesAfterARestart) {
+  for (int write = 1; write <= 3; ++write) {
+    CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 0.0, false)).status);
+    CHECK_EQUAL(static_cast<std::uint32_t>(write), windows.device->window().command.host_heartbeat);
+  }
+  pio::PioHapticDevice restarted(&windows.host->window(), hal::kDefaultHapticRange);
+  CHECK_EQUAL(WriteStatus::Written, restarted.write_command(command_of(0.0, 0.0, 0.0, false)).status);
+  CHECK_EQUAL(4U, windows.device->window().command.host_heartbeat);
+}
+
+TEST(PioHapticDevice, ABackendWithoutAWindowReportsNotOpenAndLatchesIt) {
+  pio::PioHapticDevice closed(nullptr, hal::kDefaultHapticRange);
+  CHECK_EQUAL(hal::HapticLinkState::Closed, closed.link_state());
+  hal::HapticSample sample{};
+  const hal::ReadResult read = closed.read_sample(0, sample);
+  CHECK_EQUAL(ReadStatus::Fault, read.status);
+  CHECK_EQUAL(HapticFault::NotOpen, read.reason);
+  CHECK_EQUAL(WriteStatus::Fault, closed.write_command(command_of(1.0, 0.0, 0.0)).status);
+  CHECK_EQUAL(HapticFault::NotOpen, closed.latched_fault());
+}
+
+TEST(PioHapticDevice, NeverAcceptsATornSampleWhileTheSimulatedDeviceWritesAt1kHz) {
+  // A watchdog far beyond any scheduling hiccup: this test is about consistency, not timing.
+  pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
+  sim::SimulatedDeviceThread device_thread(*device);
+  const hal::MonotonicNs end = sim::monotonic_now_ns() + 300 * kMs;
+  int reads = 0;
+  int fresh = 0;
+  int inconsistent = 0;
+  std::uint32_t previous_counter = 0;
+  int went_backwards = 0;
+  while (sim::monotonic_now_ns() < end) {
+    hal::HapticSample sample{};
+    const hal::ReadResult result = reader.read_sample(sim::monotonic_now_ns(), sample);
+    ++reads;
+    if (result.status != ReadStatus::Fresh) continue;
+    ++fresh;
+    if (!consistent_with_counter(sample)) ++inconsistent;
+    if (sample.sample_counter <= previous_counter) ++went_backwards;
+    previous_counter = sample.sample_counter;
+  }
+  device_thread.stop();
+  CHECK_EQUAL(0, inconsistent);
+  CHECK_EQUAL(0, went_backwards);
+  CHECK_TRUE(reads > 1000);
+  CHECK_TRUE(fresh >= 30);  // 300 nominal; a loaded machine may run the device late, never not at all
+  CHECK_EQUAL(HapticFault::None, reader.latched_fault());
+}
+
+TEST(PioHapticDevice, NeverAcceptsATornSampleFromAWriterHammeringTheWindow) {
+  pio::PioDeviceSide writer_side(windows.device->window());
+  std::atomic<bool> stop{false};
+  std::thread writer([&] {
+    for (std::uint32_t k = 1; !stop.load(std::memory_order_relaxed); ++k) {
+      const std::int32_t value = static_cast<std::int32_t>(k % 100000U);
+      writer_side.publish_pose(pio::PoseWords{k, {value, -value, value / 2}, {value, -value}, k, k});
+    }
+  });
+  pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
+  int fresh = 0;
+  int inconsistent = 0;
+  const hal::MonotonicNs end = sim::monotonic_now_ns() + 5'000 * kMs;
+  while (fresh < 50000 && sim::monotonic_now_ns() < end) {
+    hal::HapticSample sample{};
+    if (reader.read_sample(0, sample).status != ReadStatus::Fresh) continue;
+    ++fresh;
+    // Back to the integers the writer wrote: every field must come from the same k.
+    const long value = static_cast<long>(sample.sample_counter % 100000U);
+    if (std::lround(sample.position_mm[0] * 1e3) != value || std::lround(sample.position_mm[1] * 1e3) != -value ||
+        std::lround(sample.position_mm[2] * 1e3) != value / 2 || std::lround(sample.angles_rad[0] * 1e6) != value ||
+        std::lround(sample.angles_rad[1] * 1e6) != -value || sample.device_heartbeat != sample.sample_counter ||
+        sample.status_bits != sample.sample_counter) {
+      ++inconsistent;
+    }
+  }
+  stop = true;
+  writer.join();
+  std::printf("\n  pio_shared_memory: %d fresh samples from a hammering writer, %llu retries after a torn read, "
+              "%llu busy reads\n",
+              fresh, static_cast<unsigned long long>(reader.counters().torn_read_retries),
+              static_cast<unsigned long long>(reader.counters().busy_reads));
+  CHECK_EQUAL(0, inconsistent);
+  CHECK_TRUE(fresh >= 1000);
+}
+
+TEST(PioHapticDevice, MeasuresTheReadAndWriteOfOneCycle) {
+  constexpr int kCycles = 20000;
+  std::vector<long long> durations_ns;
+  durations_ns.reserve(kCycles);
+  hal::HapticSample sample{};
+  int fresh = 0;
+  int written = 0;
+  for (int cycle = 1; cycle <= kCycles; ++cycle) {
+    device->step(cycle * kMs);  // the device's write, not timed
+    const auto start = std::chrono::steady_clock::now();
+    const hal::ReadResult read = host->read_sample(cycle * kMs, sample);
+    const hal::WriteResult write = host->write_command(command_of(0.001 * cycle, 0.0, 1.0));
+    const auto stop = std::chrono::steady_clock::now();
+    durations_ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(stop - start).count());
+    fresh += read.status == ReadStatus::Fresh ? 1 : 0;
+    written += write.status != WriteStatus::Fault ? 1 : 0;
+  }
+  std::nth_element(durations_ns.begin(), durations_ns.begin() + kCycles / 2, durations_ns.end());
+  std::printf("\n  pio_shared_memory: read+write of one cycle: median %lld ns over %d cycles\n",
+              durations_ns[kCycles / 2], kCycles);
+  CHECK_EQUAL(kCycles, fresh);
+  CHECK_EQUAL(kCycles, written);
+}

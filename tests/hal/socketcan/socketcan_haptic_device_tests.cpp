@@ -1,0 +1,302 @@
+// The SocketCAN backend end to end through a SOCK_SEQPACKET socket pair carrying struct can_frame
+// (a vcan interface cannot be created here), against the simulated device; and against a real vcan0
+// where one exists.
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "hal/socketcan/fd_can_channel.hpp"
+#include "hal/socketcan/socketcan_haptic_device.hpp"
+#include "sim/haptic_device/can_device_link.hpp"
+#include "sim/haptic_device/simulated_haptic_device.hpp"
+#include "tests/hal/pio_shared_memory/haptic_result_strings.hpp"
+#include "tests/hal/socketcan/can_strings.hpp"
+#include "tests/sim/haptic_device/counter_pose.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using hal::HapticFault;
+using hal::ReadStatus;
+using hal::WriteStatus;
+namespace can = hal::socketcan;
+
+namespace {
+
+constexpr hal::MonotonicNs kMs = 1'000'000;
+
+hal::HapticSample marker_sample() {
+  hal::HapticSample sample{};
+  sample.position_mm[0] = 12345.0;
+  sample.sample_counter = 0xDEADU;
+  return sample;
+}
+
+hal::HapticCommand command_of(double fx, double fy, double fz, bool enable = true) {
+  return hal::HapticCommand{{fx, fy, fz}, {0.0, 0.0}, 7, enable};
+}
+
+}  // namespace
+
+TEST_GROUP(SocketCanHapticDevice) {
+  std::unique_ptr<can::FdCanChannel> host_channel;
+  std::unique_ptr<can::FdCanChannel> device_channel;
+  std::unique_ptr<sim::CanDeviceLink> device_link;
+  std::unique_ptr<sim::SimulatedHapticDevice> device;
+  std::unique_ptr<can::SocketCanHapticDevice> host;
+
+  void setup() override {
+    int fds[2];
+    CHECK_EQUAL(0, ::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds));
+    host_channel = std::make_unique<can::FdCanChannel>(fds[0]);
+    device_channel = std::make_unique<can::FdCanChannel>(fds[1]);
+    device_link = std::make_unique<sim::CanDeviceLink>(*device_channel);
+    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, test::counter_pose);
+    host = std::make_unique<can::SocketCanHapticDevice>(host_channel.get(), hal::kDefaultHapticRange);
+  }
+
+  void inject(const can_frame& frame) { CHECK_EQUAL(can::TransferStatus::Done, device_channel->send(frame)); }
+};
+
+TEST(SocketCanHapticDevice, GivesEachNewPoseOnceInMillimetresAndRadians) {
+  hal::HapticSample sample = marker_sample();
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(0, sample).status);
+  CHECK_EQUAL(hal::HapticLinkState::WaitingForDevice, host->link_state());
+
+  device->step(1 * kMs);
+  const hal::ReadResult first = host->read_sample(1 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fresh, first.status);
+  CHECK_EQUAL(1U, sample.sample_counter);
+  DOUBLES_EQUAL(-99.9, sample.position_mm[0], 1e-9);
+  DOUBLES_EQUAL(-0.05, sample.position_mm[1], 1e-9);
+  DOUBLES_EQUAL(0.025, sample.position_mm[2], 1e-9);
+  DOUBLES_EQUAL(-0.999, sample.angles_rad[0], 1e-9);
+  DOUBLES_EQUAL(0.9995, sample.angles_rad[1], 1e-9);
+  CHECK_EQUAL(1U, sample.device_heartbeat);
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
+
+  sample = marker_sample();
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(1 * kMs, sample).status);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);
+}
+
+TEST(SocketCanHapticDevice, ExtendsThe8BitWireCounterAcrossItsWrap) {
+  hal::HapticSample sample{};
+  for (std::uint32_t k = 1; k <= 600; ++k) {
+    device->step(static_cast<hal::MonotonicNs>(k) * kMs);
+    if (k % 3 == 0) continue;  // a host that misses a cycle now and then still counts right
+    CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(static_cast<hal::MonotonicNs>(k) * kMs, sample).status);
+    CHECK_EQUAL(k, sample.sample_counter);
+    CHECK_TRUE(test::consistent_with_counter(sample));
+  }
+}
+
+TEST(SocketCanHapticDevice, TakesTheNewestPoseWhenSeveralAreWaiting) {
+  for (int ms = 1; ms <= 5; ++ms) device->step(ms * kMs);
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(5 * kMs, sample).status);
+  CHECK_EQUAL(5U, sample.sample_counter);
+  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(5 * kMs, sample).status);
+}
+
+TEST(SocketCanHapticDevice, AFrozenDeviceReadsStaleThenDisconnectsAfterTheWatchdogTime) {
+  hal::HapticSample sample{};
+  for (int ms = 1; ms <= 10; ++ms) {
+    device->step(ms * kMs);
+    CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(ms * kMs, sample).status);
+  }
+  device->set_frozen(true);
+  for (hal::MonotonicNs now = 11 * kMs; now <= 10 * kMs + can::kDefaultDeviceWatchdogNs; now += kMs) {
+    device->step(now);
+    CHECK_EQUAL(ReadStatus::Stale, host->read_sample(now, sample).status);
+  }
+  CHECK_EQUAL(10U, sample.device_heartbeat);
+  const hal::ReadResult lost = host->read_sample(11 * kMs + can::kDefaultDeviceWatchdogNs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, lost.status);
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, lost.reason);
+  CHECK_EQUAL(hal::HapticLinkState::Disconnected, host->link_state());
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());
+}
+
+TEST(SocketCanHapticDevice, BadFramesOnTheWireAreRefusedCountedAndNeverApplied) {
+  device->step(1 * kMs);
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
+  const hal::HapticSample applied = sample;
+
+  can_frame pose_a;
+  can_frame pose_b;
+  CHECK_TRUE(can::encode_pose(can::PoseWire{2, {5000, 5000, 5000}, {0, 0}}, pose_a, pose_b));
+  can_frame short_a = pose_a;
+  short_a.len = 6;
+  can_frame unknown = pose_a;
+  unknown.can_id = 0x42;
+  can_frame other_counter_b = pose_b;
+  other_counter_b.data[0] = 9;
+  inject(short_a);
+  inject(unknown);
+  inject(pose_a);
+  inject(other_counter_b);
+  // A message that is not one can_frame at all.
+  const char garbage[10] = {};
+  CHECK_EQUAL(10, ::send(device_channel->fd(), garbage, sizeof garbage, 0));
+
+  sample = marker_sample();
+  const hal::ReadResult refused = host->read_sample(2 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Rejected, refused.status);
+  CHECK_EQUAL(HapticFault::BadFrame, refused.reason);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);
+  CHECK_EQUAL(1U, host->rejections().of(can::FrameRejection::WrongDlc));
+  CHECK_EQUAL(1U, host->rejections().of(can::FrameRejection::UnknownId));
+  CHECK_EQUAL(1U, host->rejections().of(can::FrameRejection::HalvesDisagree));
+  CHECK_EQUAL(1U, host->rejections().of(can::FrameRejection::WrongSize));
+  CHECK_EQUAL(4U, host->counters().bad_frames);
+
+  // A pose beyond the reach: refused as out of range.
+  CHECK_TRUE(can::encode_pose(can::PoseWire{3, {400000, 0, 0}, {0, 0}}, pose_a, pose_b));
+  inject(pose_a);
+  inject(pose_b);
+  const hal::ReadResult far = host->read_sample(3 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Rejected, far.status);
+  CHECK_EQUAL(HapticFault::SampleOutOfRange, far.reason);
+  CHECK_EQUAL(1U, host->counters().samples_out_of_range);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);
+
+  // The device's next pose comes through as if nothing happened.
+  device->step(4 * kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(4 * kMs, sample).status);
+  CHECK_EQUAL(applied.sample_counter + 1, sample.sample_counter);
+  CHECK_TRUE(test::consistent_with_counter(sample));
+}
+
+TEST(SocketCanHapticDevice, CommandsReachTheDeviceClampedAndQuantised) {
+  hal::HapticCommand command = command_of(1.5, -0.25, 0.0);
+  command.torque_nmm[0] = 123.456;
+  command.torque_nmm[1] = -0.019;
+  CHECK_EQUAL(WriteStatus::Written, host->write_command(command).status);
+  device->step(1 * kMs);
+  sim::DeviceOutput output = device->output();
+  CHECK_TRUE(output.force_applied);
+  DOUBLES_EQUAL(1.5, output.force_n[0], 1e-9);
+  DOUBLES_EQUAL(-0.25, output.force_n[1], 1e-9);
+  DOUBLES_EQUAL(123.45, output.torque_nmm[0], 1e-9);  // toward zero, 10 mN.mm steps
+  DOUBLES_EQUAL(-0.01, output.torque_nmm[1], 1e-9);
+  CHECK_EQUAL(7U, output.last_cycle_counter);
+
+  CHECK_EQUAL(WriteStatus::Clamped, host->write_command(command_of(0.0, 30.0, -40.0)).status);  // 50 N
+  device->step(2 * kMs);
+  output = device->output();
+  CHECK_TRUE(output.force_applied);
+  DOUBLES_EQUAL(3.0, output.force_n[1], 1e-9);
+  DOUBLES_EQUAL(-4.0, output.force_n[2], 1e-9);
+  CHECK_EQUAL(0U, device_link->rejections().total());
+}
+
+TEST(SocketCanHapticDevice, ANonFiniteCommandSendsZeroForceWithEnableOff) {
+  CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(2.0, 0.0, 0.0)).status);
+  device->step(1 * kMs);
+  CHECK_TRUE(device->output().force_applied);
+  const hal::WriteResult rejected = host->write_command(command_of(2.0, 0.0, std::nan("")));
+  CHECK_EQUAL(WriteStatus::Rejected, rejected.status);
+  CHECK_EQUAL(HapticFault::CommandNotFinite, rejected.reason);
+  device->step(2 * kMs);
+  const sim::DeviceOutput output = device->output();
+  CHECK_FALSE(output.force_applied);
+  DOUBLES_EQUAL(0.0, output.force_n[0], 0.0);
+  CHECK_EQUAL(2U, output.commands_accepted);  // it did arrive: as zero, disabled
+}
+
+TEST(SocketCanHapticDevice, AFullQueueDropsTheCommandAndLatchesTheFault) {
+  const can_frame filler{};
+  int queued = 0;
+  while (queued < 1'000'000 && host_channel->send(filler) == can::TransferStatus::Done) ++queued;
+  CHECK_TRUE(queued > 0);
+  CHECK_TRUE(queued < 1'000'000);
+  const hal::WriteResult full = host->write_command(command_of(1.0, 0.0, 0.0));
+  CHECK_EQUAL(WriteStatus::Fault, full.status);
+  CHECK_EQUAL(HapticFault::TransportFull, full.reason);
+  CHECK_EQUAL(HapticFault::TransportFull, host->latched_fault());
+  CHECK_EQUAL(1U, host->counters().transport_errors);
+}
+
+TEST(SocketCanHapticDevice, AClosedPeerIsATransportFault) {
+  device_link.reset();
+  device.reset();
+  device_channel.reset();
+  hal::HapticSample sample{};
+  const hal::ReadResult read = host->read_sample(1 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, read.status);
+  CHECK_EQUAL(HapticFault::TransportError, read.reason);
+  CHECK_EQUAL(hal::HapticLinkState::Disconnected, host->link_state());
+  CHECK_EQUAL(WriteStatus::Fault, host->write_command(command_of(0.0, 0.0, 0.0)).status);
+}
+
+TEST(SocketCanHapticDevice, ABackendWithoutAChannelReportsNotOpen) {
+  can::SocketCanHapticDevice closed(nullptr, hal::kDefaultHapticRange);
+  CHECK_EQUAL(hal::HapticLinkState::Closed, closed.link_state());
+  hal::HapticSample sample{};
+  CHECK_EQUAL(HapticFault::NotOpen, closed.read_sample(0, sample).reason);
+  CHECK_EQUAL(HapticFault::NotOpen, closed.write_command(command_of(0.0, 0.0, 0.0)).reason);
+  CHECK_EQUAL(HapticFault::NotOpen, closed.latched_fault());
+}
+
+TEST(SocketCanHapticDevice, MeasuresTheReadAndWriteOfOneCycle) {
+  constexpr int kCycles = 20000;
+  std::vector<long long> durations_ns;
+  durations_ns.reserve(kCycles);
+  hal::HapticSample sample{};
+  int fresh = 0;
+  int written = 0;
+  for (int cycle = 1; cycle <= kCycles; ++cycle) {
+    device->step(cycle * kMs);  // the device's frames (and its reading of the last command), not timed
+    const auto start = std::chrono::steady_clock::now();
+    const hal::ReadResult read = host->read_sample(cycle * kMs, sample);
+    const hal::WriteResult write = host->write_command(command_of(0.0001 * cycle, 0.0, 1.0));
+    const auto stop = std::chrono::steady_clock::now();
+    durations_ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(stop - start).count());
+    fresh += read.status == ReadStatus::Fresh ? 1 : 0;
+    written += write.status != WriteStatus::Fault ? 1 : 0;
+  }
+  std::nth_element(durations_ns.begin(), durations_ns.begin() + kCycles / 2, durations_ns.end());
+  std::printf("\n  socketcan (socketpair): read+write of one cycle: median %lld ns over %d cycles "
+              "(3 frames received, 2 sent)\n",
+              durations_ns[kCycles / 2], kCycles);
+  CHECK_EQUAL(kCycles, fresh);
+  CHECK_EQUAL(kCycles, written);
+}
+
+TEST_GROUP(SocketCanOnVcan0) {};
+
+// Needs a vcan0 interface (ip link add dev vcan0 type vcan; ip link set up vcan0); skipped otherwise.
+TEST(SocketCanOnVcan0, PosesAndCommandsCrossARealCanInterface) {
+  std::string error;
+  const canid_t device_to_host[] = {can::kPoseAId, can::kPoseBId, can::kStatusId};
+  const canid_t host_to_device[] = {can::kForceId, can::kTorqueId};
+  const int host_fd = can::open_can_raw_socket("vcan0", device_to_host, 3, error);
+  if (host_fd < 0) {
+    std::printf("\n  SKIPPED SocketCanOnVcan0: %s\n", error.c_str());
+    return;
+  }
+  can::FdCanChannel host_channel(host_fd);
+  const int device_fd = can::open_can_raw_socket("vcan0", host_to_device, 2, error);
+  CHECK_TEXT(device_fd >= 0, error.c_str());
+  can::FdCanChannel device_channel(device_fd);
+  sim::CanDeviceLink device_link(device_channel);
+  sim::SimulatedHapticDevice device(device_link, test::counter_pose);
+  can::SocketCanHapticDevice host(&host_channel, hal::kDefaultHapticRange);
+
+  hal::HapticSample sample{};
+  device.step(1 * kMs);
+  CHECK_EQUAL(ReadStatus::Fresh, host.read_sample(1 * kMs, sample).status);
+  CHECK_TRUE(test::consistent_with_counter(sample));
+  CHECK_EQUAL(WriteStatus::Written, host.write_command(command_of(0.0, 1.0, 0.0)).status);
+  device.step(2 * kMs);
+  DOUBLES_EQUAL(1.0, device.output().force_n[1], 1e-9);
+}
