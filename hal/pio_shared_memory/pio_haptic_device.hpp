@@ -6,7 +6,7 @@
 #include <cstdint>
 
 #include "hal/haptic_device.hpp"
-#include "hal/pio_shared_memory/heartbeat_watchdog.hpp"
+#include "hal/heartbeat_watchdog.hpp"
 #include "hal/pio_shared_memory/shared_window_layout.hpp"
 
 namespace stencil::hal::pio_shared_memory {

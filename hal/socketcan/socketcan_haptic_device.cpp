@@ -4,7 +4,7 @@
 
 #include <algorithm>
 
-#include "hal/pio_shared_memory/haptic_range_checks.hpp"
+#include "hal/haptic_range_checks.hpp"
 
 namespace stencil::hal::socketcan {
 

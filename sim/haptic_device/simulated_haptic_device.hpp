@@ -10,7 +10,7 @@
 
 #include "hal/clock.hpp"
 #include "hal/haptic_device.hpp"
-#include "hal/pio_shared_memory/heartbeat_watchdog.hpp"
+#include "hal/heartbeat_watchdog.hpp"
 #include "sim/haptic_device/device_side_link.hpp"
 
 namespace stencil::sim {

@@ -1,6 +1,5 @@
 // The range rules of hal::HapticRange as functions: which samples are refused, how a command is
-// clamped. Shared by both haptic backends (it lives here because only hal/haptic_device.hpp is the
-// interface's). Real-time safe, header-only.
+// clamped. Shared by both haptic backends. Real-time safe, header-only.
 #pragma once
 
 #include <cmath>

@@ -1,6 +1,6 @@
 // HeartbeatWatchdog: says whether a counter that the other side increments has moved recently.
 // Shared by both haptic backends and the simulated device (host side: the device heartbeat; device
-// side: the host heartbeat). It lives here because only hal/haptic_device.hpp is the interface's.
+// side: the host heartbeat).
 #pragma once
 
 #include <cstdint>
