@@ -99,7 +99,10 @@
 //
 // The rig's mill (sim/mill): each axis's home switch is closed below machine coordinate 0 and open
 // from 0 up; so `H 11H` (seek bit 1 = 0, switch open) with the input mux on that axis homes the axis
-// onto machine coordinate 0 from below, leaving its slack on the negative side, register = 0.
+// onto machine coordinate 0 exactly, register = 0. Its last steps were +, so a following + move moves
+// the axis at once and a - move first turns the axis's backlash (80/32/80 steps) without moving it.
+// (`H 1` would seek the switch CLOSING while stepping +, which never happens from inside the
+// workspace: it steps + until the far hard stop and, with no limit inputs wired, on and on.)
 //
 // Exact byte sequences (what the fake expects) for X = channel 0, Y = 1, Z = 2, drivers on:
 //   select channel c:   "B <40H + 1 + 4c>\r" "B 7\r" "/B 7\r"   e.g. Y: "B 45H\r" "B 7\r" "/B 7\r"

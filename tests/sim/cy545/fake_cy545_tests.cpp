@@ -350,3 +350,31 @@ TEST(FakeCy545, SpindleFollowsGeneralPurposeOutputFourWithoutTouchingTheChannel)
   CHECK_TRUE(bench.send("B 51H\rB 7\r/B 7\r"));
   CHECK_FALSE(bench.mill.spindle_on());
 }
+
+TEST(FakeCy545, TheByteSequencesDocumentedForTheDriverWork) {
+  bench.mill.place_axis(Axis::y, 1000, StepDirection::positive);
+  CHECK_TRUE(bench.send("\r"));
+  // Select Y, move 100 steps +.
+  CHECK_TRUE(bench.send("B 45H\rB 7\r/B 7\rN 100\r+\rG\r"));
+  bench.advance_ms(100);
+  LONGS_EQUAL(1100, bench.mill.axis_position_steps(Axis::y));
+  // Home Y: read strobe on with Y's address, seek bit 1 low.
+  CHECK_TRUE(bench.send("B 65H\rH 11H\r"));
+  bench.advance_ms(10'000);
+  CHECK_FALSE(bench.fake.chip().busy());
+  LONGS_EQUAL(0, bench.mill.axis_position_steps(Axis::y));
+  STRCMP_EQUAL("P=0\r", bench.query("? P\r").c_str());
+  // After homing a + move moves at once.
+  CHECK_TRUE(bench.send("B 45H\rN 640\r+\rG\r"));
+  bench.advance_ms(640);
+  DOUBLES_EQUAL(1.0, bench.mill.axis_position_mm(Axis::y), 1e-12);
+  STRCMP_EQUAL("P=640\r", bench.query("? P\r").c_str());
+  LONGS_EQUAL(x0, bench.mill.axis_position_steps(Axis::x));
+  LONGS_EQUAL(z0, bench.mill.axis_position_steps(Axis::z));
+  // Spindle on and off.
+  CHECK_TRUE(bench.send("B 53H\rB 7\r/B 7\r"));
+  CHECK_TRUE(bench.mill.spindle_on());
+  CHECK_TRUE(bench.send("B 51H\rB 7\r/B 7\r"));
+  CHECK_FALSE(bench.mill.spindle_on());
+  LONGS_EQUAL(0, bench.fake.chip().counters().malformed_lines);
+}
