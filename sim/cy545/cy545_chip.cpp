@@ -51,7 +51,7 @@ std::string Cy545Chip::take_output() { return std::exchange(output_, std::string
 std::uint8_t Cy545Chip::pin_levels() const {
   std::uint8_t levels = static_cast<std::uint8_t>(latches_ & ~kBusyBit);
   if (!busy()) levels = static_cast<std::uint8_t>(levels | kBusyBit);
-  if (((latches_ >> kBitReadStrobe) & 1u) != 0) {
+  if (((static_cast<unsigned>(latches_) >> kBitReadStrobe) & 1u) != 0) {
     const int address = (latches_ >> kBitAddressLow) & 0x7;
     const std::uint8_t data_bit = static_cast<std::uint8_t>(1u << kBitData);
     levels = static_cast<std::uint8_t>(board_.input_level(address) ? (levels | data_bit) : (levels & ~data_bit));
@@ -62,7 +62,7 @@ std::uint8_t Cy545Chip::pin_levels() const {
 bool Cy545Chip::bit_matches(std::uint32_t bit_argument) const {
   const int bit = static_cast<int>(bit_argument & 0x7);
   const bool want_high = bit_argument < 0x10;
-  const bool high = ((pin_levels() >> bit) & 1u) != 0;
+  const bool high = ((static_cast<unsigned>(pin_levels()) >> bit) & 1u) != 0;
   return high == want_high;
 }
 

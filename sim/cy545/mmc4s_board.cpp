@@ -12,7 +12,7 @@ namespace {
 
 namespace rig = board::sherline_suzuki;
 
-bool bit_of(std::uint8_t bits, int bit) { return ((bits >> bit) & 1u) != 0; }
+bool bit_of(std::uint8_t bits, int bit) { return ((static_cast<unsigned>(bits) >> bit) & 1u) != 0; }
 int address_of(std::uint8_t bits) { return (bits >> kBitAddressLow) & 0x7; }
 
 }  // namespace
