@@ -1,0 +1,71 @@
+// The MMC-4S multiplexer board: decodes the CY545's user bits into channel selection, outputs and inputs.
+#include "sim/cy545/mmc4s_board.hpp"
+
+#include <cstddef>
+
+#include "board/sherline_suzuki/rig_constants.hpp"
+#include "sim/cy545/cy545_protocol.hpp"
+
+namespace stencil::sim::cy545 {
+
+namespace {
+
+namespace rig = board::sherline_suzuki;
+
+bool bit_of(std::uint8_t bits, int bit) { return ((static_cast<unsigned>(bits) >> bit) & 1u) != 0; }
+int address_of(std::uint8_t bits) { return (bits >> kBitAddressLow) & 0x7; }
+
+}  // namespace
+
+Mmc4sBoard::Mmc4sBoard(SimulatedMill& mill) : mill_(mill) {
+  mill_.set_drivers_enabled(false);
+  mill_.set_spindle_on(false);
+}
+
+void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after) {
+  mill_.set_drivers_enabled(bit_of(after, kBitDriverEnable));
+  const bool strobe_rising = !bit_of(before, kBitWriteStrobe) && bit_of(after, kBitWriteStrobe);
+  if (!strobe_rising) return;
+  const int port = address_of(after);
+  if (port < kMotorChannels) {
+    selected_channel_ = port;
+    ++channel_selections_;
+    return;
+  }
+  outputs_[static_cast<std::size_t>(port)] = bit_of(after, kBitData);
+  if (port == rig::kMmc4s.spindle_output) mill_.set_spindle_on(outputs_[static_cast<std::size_t>(port)]);
+}
+
+std::optional<Axis> Mmc4sBoard::axis_of_channel(int channel) const {
+  for (int axis = 0; axis < rig::kAxisCount; ++axis) {
+    if (rig::kMmc4s.motor_channel[axis] == channel) return static_cast<Axis>(axis);
+  }
+  return std::nullopt;
+}
+
+bool Mmc4sBoard::input_level(int port) const {
+  for (int axis = 0; axis < rig::kAxisCount; ++axis) {
+    if (rig::kMmc4s.home_sensor_input[axis] == port) return mill_.home_switch_closed(static_cast<Axis>(axis));
+  }
+  if (port >= kMotorChannels && port < kMuxPorts) return general_inputs_[static_cast<std::size_t>(port)];
+  return false;
+}
+
+void Mmc4sBoard::step_pulse(StepDirection direction) {
+  const std::optional<Axis> axis = selected_channel_ ? axis_of_channel(*selected_channel_) : std::nullopt;
+  if (!axis) {
+    ++steps_to_no_channel_;
+    return;
+  }
+  static_cast<void>(mill_.step_motor(*axis, direction));
+}
+
+bool Mmc4sBoard::general_output(int port) const {
+  return port >= kMotorChannels && port < kMuxPorts && outputs_[static_cast<std::size_t>(port)];
+}
+
+void Mmc4sBoard::set_general_input(int port, bool level) {
+  if (port >= kMotorChannels && port < kMuxPorts) general_inputs_[static_cast<std::size_t>(port)] = level;
+}
+
+}  // namespace stencil::sim::cy545

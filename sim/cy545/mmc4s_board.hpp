@@ -1,0 +1,47 @@
+// The MMC-4S multiplexer board between the CY545's user bits and the mill: channel latch, general-purpose
+// outputs (spindle), input mux (home sensors), driver enable. Wiring and rules: cy545_protocol.hpp.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <optional>
+
+#include "sim/mill/simulated_mill.hpp"
+
+namespace stencil::sim::cy545 {
+
+class Mmc4sBoard {
+ public:
+  explicit Mmc4sBoard(SimulatedMill& mill);
+
+  // The chip's user-bit output latches changed from `before` to `after` (bit 6 excluded).
+  void on_user_bits_written(std::uint8_t before, std::uint8_t after);
+
+  // The level of input-mux port `port` (0..7).
+  [[nodiscard]] bool input_level(int port) const;
+
+  // A step pulse with the chip's direction line: goes to the selected channel's motor, if any.
+  void step_pulse(StepDirection direction);
+
+  [[nodiscard]] std::optional<int> selected_channel() const { return selected_channel_; }
+  [[nodiscard]] bool general_output(int port) const;
+  void set_general_input(int port, bool level);
+
+  [[nodiscard]] std::int64_t steps_to_no_channel() const { return steps_to_no_channel_; }
+  [[nodiscard]] std::int64_t channel_selections() const { return channel_selections_; }
+
+  [[nodiscard]] SimulatedMill& mill() { return mill_; }
+  [[nodiscard]] const SimulatedMill& mill() const { return mill_; }
+
+ private:
+  [[nodiscard]] std::optional<Axis> axis_of_channel(int channel) const;
+
+  SimulatedMill& mill_;
+  std::optional<int> selected_channel_;
+  std::array<bool, 8> outputs_{};         // general-purpose outputs 4..7 (0..3 unused)
+  std::array<bool, 8> general_inputs_{};  // general-purpose inputs 4..7
+  std::int64_t steps_to_no_channel_ = 0;
+  std::int64_t channel_selections_ = 0;
+};
+
+}  // namespace stencil::sim::cy545
