@@ -1,0 +1,98 @@
+// The mill behind MachineLink: a CY545 stepper controller on an MMC-4S multiplexer board, over
+// RS-232. One motor channel is driven at a time; each machine update is turned into, per axis that
+// moves (in the target's order):
+//
+//   B <40H + 1 + 4c>H   drivers on, output-mux address c (the axis's motor channel)
+//   B 7  /  /B 7        write strobe up and down: the board latches channel c
+//   N <steps>           the step count of this leg
+//   + or -              its direction
+//   G                   go; the chip is busy for steps / rate seconds and reads nothing meanwhile
+//
+// The chip has a three-character input buffer and ignores input while a move runs, so nothing is
+// sent before the previous move is known to be over: on a real port CTS holds the bytes (the chip
+// drops CTS while busy) and the driver also waits the move's computed duration plus a margin; on a
+// pseudo-terminal (no modem lines) the computed wait is all there is, and verify() confirms with a
+// query. Homing: per axis, select the channel, put its home switch on the input line (B <61H + 4c>H:
+// read strobe on, input address c) and seek (H 11H: down into the switch, up until it opens). The
+// chip keeps one position register for every channel; the driver tracks it (relative moves add to
+// it) and compares it with "? P" in verify().
+//
+// Rates are given to the chip in steps per second (R, F), as the simulated CY545 takes them; the
+// real chip takes an index into its rate table: a rig build must convert (not done: no rig here).
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "hal/clock.hpp"
+#include "hal/cy545/cy545_commands.hpp"
+#include "hal/cy545/serial_port.hpp"
+#include "hal/machine_link.hpp"
+
+namespace stencil::hal::cy545 {
+
+struct Cy545Config {
+  std::uint32_t step_rate = 1000;            // steps/s of every move (R and F: no ramp)
+  std::uint32_t homing_rate = 1000;          // steps/s while seeking home
+  std::int32_t homing_travel_steps = 40960;  // the longest seek of one axis (64 mm), bounds its wait
+  double update_period_s = 1.0 / 30.0;       // a move that takes longer is refused
+  MonotonicNs reply_timeout_ns = 50'000'000; // a query's answer
+  MonotonicNs pace_margin_ns = 2'000'000;    // added to every computed move time
+  int start_attempts = 20;                   // carriage returns and queries at start-up
+  std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
+  std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
+  std::uint8_t spindle_output = 4;                            // general-purpose output (1 = on)
+};
+
+class Cy545Link final : public MachineLink {
+ public:
+  Cy545Link(SerialPort& port, Clock& clock, const Cy545Config& config);
+
+  MachineResult start(MonotonicNs deadline_ns) override;
+  MachineResult home(MonotonicNs deadline_ns) override;
+  MachineResult declare_home(MonotonicNs deadline_ns) override;
+  MachineResult move(const MachineTarget& target, MonotonicNs deadline_ns) override;
+  MachineResult verify(MonotonicNs deadline_ns) override;
+  MachineResult set_spindle(bool on, MonotonicNs deadline_ns) override;
+  void hold() override;
+  void resume() override;
+  MachineResult stop(MonotonicNs deadline_ns) override;
+  [[nodiscard]] MachineStatus status() const override;
+  [[nodiscard]] std::array<int, 3> home_approach() const override { return {1, 1, 1}; }
+
+  // For tests and the fault report: the last reply's bytes that did not parse, and why.
+  [[nodiscard]] const char* last_error() const { return last_error_; }
+
+ private:
+  void latch_fault(MachineFault fault);
+  MachineResult fail(MachineFault fault);
+  [[nodiscard]] MachineResult refuse(MachineRefusal refusal) const;
+  // Sends one command once the chip is free; false (fault latched) when the port fails.
+  bool send(const CommandBytes& command, MonotonicNs deadline_ns);
+  bool send_bits(std::uint8_t code, MonotonicNs deadline_ns);
+  bool latch(MonotonicNs deadline_ns);  // write strobe up and down
+  bool select_channel(std::uint8_t channel, MonotonicNs deadline_ns);
+  // Waits until the chip is free (the computed end of its move), but not past the deadline.
+  bool wait_free(MonotonicNs deadline_ns);
+  bool query(char letter, std::uint32_t& value, MonotonicNs deadline_ns);
+
+  SerialPort& port_;
+  Clock& clock_;
+  Cy545Config config_;
+  MachineState state_ = MachineState::Closed;
+  MachineState before_hold_ = MachineState::Closed;
+  MachineFault fault_ = MachineFault::None;
+  std::array<std::int32_t, 3> commanded_{};
+  std::uint32_t position_register_ = 0;  // what "? P" must answer (24 bits)
+  int selected_channel_ = -1;            // the channel the board has latched, -1 unknown
+  bool spindle_on_ = false;
+  bool drivers_on_ = false;
+  bool homed_ = false;
+  MonotonicNs busy_until_ns_ = 0;
+  std::uint64_t moves_done_ = 0;
+  std::uint64_t bytes_sent_ = 0;
+  std::uint64_t bytes_received_ = 0;
+  char last_error_[160] = {};
+};
+
+}  // namespace stencil::hal::cy545

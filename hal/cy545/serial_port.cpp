@@ -1,0 +1,155 @@
+// The CY545's serial port: termios set-up and deadline-bounded byte I/O with poll().
+#include "hal/cy545/serial_port.hpp"
+
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/ioctl.h>
+#include <termios.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace stencil::hal::cy545 {
+namespace {
+
+// Milliseconds until the deadline for poll(), rounded up so a wait never ends early; 0 when past.
+int poll_timeout_ms(MonotonicNs deadline_ns, const Clock& clock) {
+  const MonotonicNs left = deadline_ns - clock.now_ns();
+  if (left <= 0) {
+    return 0;
+  }
+  const MonotonicNs ms = (left + 999'999) / 1'000'000;
+  return ms > 60'000 ? 60'000 : static_cast<int>(ms);
+}
+
+}  // namespace
+
+SerialPort::~SerialPort() { close(); }
+
+void SerialPort::close() {
+  if (fd_ >= 0) {
+    ::close(fd_);
+    fd_ = -1;
+  }
+}
+
+bool SerialPort::open(const char* path, char (&error)[256]) {
+  close();
+  const int fd = ::open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) {
+    std::snprintf(error, sizeof error, "%s: cannot open the serial port: %s", path, std::strerror(errno));
+    return false;
+  }
+  if (!isatty(fd)) {
+    std::snprintf(error, sizeof error, "%s: not a serial port (a tty was expected)", path);
+    ::close(fd);
+    return false;
+  }
+  termios settings{};
+  if (tcgetattr(fd, &settings) != 0) {
+    std::snprintf(error, sizeof error, "%s: cannot read the port settings: %s", path, std::strerror(errno));
+    ::close(fd);
+    return false;
+  }
+  // A pseudo-terminal has no modem lines: TIOCMGET fails on it.
+  int lines = 0;
+  modem_lines_ = ioctl(fd, TIOCMGET, &lines) == 0;
+  cfmakeraw(&settings);
+  cfsetispeed(&settings, B57600);
+  cfsetospeed(&settings, B57600);
+  settings.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | CSTOPB);
+  settings.c_cflag |= CS8 | CREAD | CLOCAL;
+  if (modem_lines_) {
+    settings.c_cflag |= CRTSCTS;  // the chip drops CTS (its user bit 6) while busy
+  } else {
+    settings.c_cflag &= ~static_cast<tcflag_t>(CRTSCTS);
+  }
+  settings.c_cc[VMIN] = 1;  // with O_NONBLOCK: EAGAIN when nothing waits (VMIN 0 would read 0, like a hang-up)
+  settings.c_cc[VTIME] = 0;
+  if (tcsetattr(fd, TCSANOW, &settings) != 0) {
+    std::snprintf(error, sizeof error, "%s: cannot set 57600 8N1 raw: %s", path, std::strerror(errno));
+    ::close(fd);
+    return false;
+  }
+  fd_ = fd;
+  return true;
+}
+
+PortIo SerialPort::write_all(std::string_view bytes, MonotonicNs deadline_ns, const Clock& clock) {
+  if (fd_ < 0) {
+    return PortIo::Failed;
+  }
+  std::size_t sent = 0;
+  while (sent < bytes.size()) {
+    const ssize_t count = ::write(fd_, bytes.data() + sent, bytes.size() - sent);
+    if (count > 0) {
+      sent += static_cast<std::size_t>(count);
+      continue;
+    }
+    if (count < 0 && errno == EIO) {
+      return PortIo::Closed;
+    }
+    if (count < 0 && errno != EAGAIN && errno != EINTR) {
+      return PortIo::Failed;
+    }
+    pollfd request{fd_, POLLOUT, 0};
+    const int ready = ::poll(&request, 1, poll_timeout_ms(deadline_ns, clock));
+    if (ready == 0) {
+      return PortIo::TimedOut;
+    }
+    if (ready > 0 && (request.revents & POLLHUP) != 0) {
+      return PortIo::Closed;
+    }
+  }
+  return PortIo::Ok;
+}
+
+PortIo SerialPort::read_line(char* buffer, std::size_t capacity, std::size_t& size, MonotonicNs deadline_ns,
+                             const Clock& clock) {
+  size = 0;
+  if (fd_ < 0) {
+    return PortIo::Failed;
+  }
+  while (true) {
+    char byte = 0;
+    const ssize_t count = ::read(fd_, &byte, 1);
+    if (count == 1) {
+      if (size == capacity) {
+        return PortIo::Failed;
+      }
+      buffer[size++] = byte;
+      if (byte == '\r') {
+        return PortIo::Ok;
+      }
+      continue;
+    }
+    if (count == 0 || (count < 0 && errno == EIO)) {
+      return PortIo::Closed;  // a pseudo-terminal whose master closed reads EIO
+    }
+    if (errno != EAGAIN && errno != EINTR) {
+      return PortIo::Failed;
+    }
+    const int timeout = poll_timeout_ms(deadline_ns, clock);
+    if (timeout == 0 && clock.now_ns() >= deadline_ns) {
+      return PortIo::TimedOut;
+    }
+    pollfd request{fd_, POLLIN, 0};
+    const int ready = ::poll(&request, 1, timeout);
+    if (ready == 0) {
+      return PortIo::TimedOut;
+    }
+    if (ready > 0 && (request.revents & (POLLIN)) == 0 && (request.revents & POLLHUP) != 0) {
+      return PortIo::Closed;
+    }
+  }
+}
+
+void SerialPort::discard_input() {
+  if (fd_ >= 0) {
+    tcflush(fd_, TCIFLUSH);
+  }
+}
+
+}  // namespace stencil::hal::cy545

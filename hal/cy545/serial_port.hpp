@@ -1,0 +1,50 @@
+// The RS-232 port to the CY545: opened and configured once (57600 8N1, raw, CRTSCTS where the port
+// has modem lines), then byte I/O that never waits past a deadline.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string_view>
+
+#include "hal/clock.hpp"
+
+namespace stencil::hal::cy545 {
+
+enum class PortIo : std::uint8_t {
+  Ok,
+  TimedOut,  // the deadline passed first
+  Closed,    // the other end hung up (unplugged cable, closed pseudo-terminal)
+  Failed,    // another error from the port
+};
+
+class SerialPort {
+ public:
+  SerialPort() = default;
+  ~SerialPort();
+  SerialPort(const SerialPort&) = delete;
+  SerialPort& operator=(const SerialPort&) = delete;
+
+  // Init-time. Opens `path` and configures it. False with a message naming the path and the
+  // failing step (not a tty, cannot open, termios refused) in `error`.
+  [[nodiscard]] bool open(const char* path, char (&error)[256]);
+  void close();
+  [[nodiscard]] bool is_open() const { return fd_ >= 0; }
+  // A real UART has modem lines (CTS holds the bytes while the chip is busy); a pseudo-terminal
+  // has none, so the driver paces commands by their duration instead.
+  [[nodiscard]] bool has_modem_lines() const { return modem_lines_; }
+
+  // Writes every byte by the deadline.
+  [[nodiscard]] PortIo write_all(std::string_view bytes, MonotonicNs deadline_ns, const Clock& clock);
+  // Reads bytes up to and including a carriage return into `buffer` (at most `capacity` bytes;
+  // more before a CR is Failed). `size` is what was read, whatever the outcome.
+  [[nodiscard]] PortIo read_line(char* buffer, std::size_t capacity, std::size_t& size, MonotonicNs deadline_ns,
+                                 const Clock& clock);
+  // Drops whatever waits to be read (stale replies before a fresh exchange).
+  void discard_input();
+
+ private:
+  int fd_ = -1;
+  bool modem_lines_ = false;
+};
+
+}  // namespace stencil::hal::cy545

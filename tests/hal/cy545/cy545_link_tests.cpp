@@ -1,0 +1,302 @@
+// The CY545 driver against the simulated CY545 on a real pseudo-terminal (wall time), against a
+// scripted peer that only records bytes, and against faults: no answer, garbage, a wrong position,
+// the port closed, a path that is not a tty.
+#include <fcntl.h>
+#include <poll.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <string>
+#include <thread>
+
+#include "hal/cy545/cy545_link.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
+#include "sim/cy545/fake_cy545.hpp"
+#include "sim/cy545/fake_cy545_runner.hpp"
+#include "sim/mill/simulated_mill.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::hal;
+using namespace stencil::hal::cy545;
+using stencil::sim::Axis;
+using stencil::sim::StepDirection;
+
+namespace {
+
+constexpr MonotonicNs kMs = 1'000'000;
+
+Cy545Config fast_homing_config() {
+  Cy545Config config;
+  config.homing_rate = 20000;        // the fake seeks at F: quick in tests
+  config.homing_travel_steps = 2000;  // the test puts every axis within 200 steps of its switch
+  return config;
+}
+
+// The simulated mill with every axis a little above its home switch, the fake CY545 on a pty
+// serviced in real time, and the driver on the pty's other end.
+struct Bench {
+  sim::SimulatedMill mill{sim::sherline_mill_config()};
+  bool placed = place_near_home(mill);
+  sim::cy545::FakeCy545 fake{mill, sim::cy545::FakeCy545Runner::monotonic_now_ns()};
+  posix_clock::MonotonicClock clock;
+  SerialPort port;
+  bool opened = open(port, fake.slave_path());
+  Cy545Link link;
+  sim::cy545::FakeCy545Runner runner{fake};
+
+  explicit Bench(const Cy545Config& config = fast_homing_config()) : link(port, clock, config) {}
+
+  static bool place_near_home(sim::SimulatedMill& mill) {
+    mill.place_axis(Axis::x, 150, StepDirection::positive);
+    mill.place_axis(Axis::y, 60, StepDirection::positive);
+    mill.place_axis(Axis::z, 190, StepDirection::positive);
+    return true;
+  }
+  static bool open(SerialPort& port, const std::string& path) {
+    char error[256] = {};
+    CHECK_TEXT(port.open(path.c_str(), error), error);
+    return true;
+  }
+  MonotonicNs in(MonotonicNs ns) const { return clock.now_ns() + ns; }
+  std::int64_t motor(Axis axis) {
+    return runner.with_fake([&](sim::cy545::FakeCy545&) { return mill.motor_position_steps(axis); });
+  }
+  std::int64_t axis(Axis a) {
+    return runner.with_fake([&](sim::cy545::FakeCy545&) { return mill.axis_position_steps(a); });
+  }
+  void start_and_home() {
+    const MachineResult started = link.start(in(2000 * kMs));
+    CHECK_TEXT(started.done, link.last_error());
+    const MachineResult homed = link.home(in(5000 * kMs));
+    CHECK_TEXT(homed.done, link.last_error());
+  }
+};
+
+MachineTarget target(std::int32_t x, std::int32_t y, std::int32_t z, std::array<std::uint8_t, 3> order = {0, 1, 2},
+                     bool cutting = true) {
+  return {{x, y, z}, order, cutting};
+}
+
+}  // namespace
+
+TEST_GROUP(Cy545Link){};
+
+TEST(Cy545Link, StartsHomesEveryAxisOnItsSwitchAndMovesTheMotorsByExactSteps) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.status().state == MachineState::Homed);
+  // Homing ends at the switch edge, the last steps upward: every axis at 0.
+  CHECK_EQUAL(0, bench.axis(Axis::x));
+  CHECK_EQUAL(0, bench.axis(Axis::y));
+  CHECK_EQUAL(0, bench.axis(Axis::z));
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  // The motors stand a backlash above their axes after homing's last, upward steps.
+  const std::int64_t home_x = bench.motor(Axis::x), home_y = bench.motor(Axis::y), home_z = bench.motor(Axis::z);
+  const MachineTarget path[] = {target(10, 12, 8), target(25, 4, 8, {1, 0, 2}), target(25, 4, -3, {2, 1, 0}),
+                                target(13, 20, -3, {1, 0, 2}), target(13, 20, 10)};
+  for (const MachineTarget& t : path) {
+    const MachineResult moved = bench.link.move(t, bench.in(500 * kMs));
+    CHECK_TEXT(moved.done, bench.link.last_error());
+  }
+  CHECK_EQUAL(13, bench.motor(Axis::x) - home_x);
+  CHECK_EQUAL(20, bench.motor(Axis::y) - home_y);
+  CHECK_EQUAL(10, bench.motor(Axis::z) - home_z);
+  const MachineResult verified = bench.link.verify(bench.in(200 * kMs));
+  CHECK_TEXT(verified.done, bench.link.last_error());
+  CHECK_EQUAL(5U, bench.link.status().moves_done);
+  CHECK(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.spindle_on(); }));
+}
+
+TEST(Cy545Link, RefusesWhatItMustNotDoAndSendsNothingForIt) {
+  Bench bench;
+  CHECK(bench.link.move(target(1, 0, 0), bench.in(200 * kMs)).refusal == MachineRefusal::NotHomed);
+  bench.start_and_home();
+  CHECK(bench.link.move(target(1, 0, 0), bench.in(200 * kMs)).refusal == MachineRefusal::SpindleOff);
+  const std::int64_t home_x = bench.motor(Axis::x);
+  CHECK(bench.link.move(target(1, 0, 0, {0, 1, 2}, false), bench.in(200 * kMs)).done);  // not cutting: allowed
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  CHECK(bench.link.move(target(1, 0, 0, {0, 0, 2}), bench.in(200 * kMs)).refusal == MachineRefusal::BadTarget);
+  CHECK(bench.link.move(target(60, 0, 0), bench.in(200 * kMs)).refusal == MachineRefusal::TooLong);
+  CHECK(bench.link.move(target(20, 0, 0), bench.in(5 * kMs)).refusal == MachineRefusal::DeadlineTooShort);
+  bench.link.hold();
+  CHECK(bench.link.move(target(2, 0, 0), bench.in(200 * kMs)).refusal == MachineRefusal::Held);
+  bench.link.resume();
+  CHECK(bench.link.move(target(2, 0, 0), bench.in(200 * kMs)).done);
+  CHECK_EQUAL(2, bench.motor(Axis::x) - home_x);
+}
+
+TEST(Cy545Link, StopTurnsSpindleAndDriversOffAndWantsHomingAgain) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  CHECK(bench.link.stop(bench.in(200 * kMs)).done);
+  // Give the fake a moment to read the last bytes.
+  usleep(20000);
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.drivers_enabled(); }));
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.spindle_on(); }));
+  CHECK(bench.link.status().state == MachineState::Stopped);
+  CHECK(bench.link.move(target(1, 0, 0, {0, 1, 2}, false), bench.in(200 * kMs)).refusal == MachineRefusal::NotHomed);
+}
+
+TEST(Cy545Link, AReplyThatNeverComesIsATimeoutFaultWithinItsBound) {
+  Bench bench;
+  bench.start_and_home();
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_replies_suppressed(true);
+    return 0;
+  });
+  const auto before = std::chrono::steady_clock::now();
+  const MachineResult verified = bench.link.verify(bench.in(1000 * kMs));
+  const double waited_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - before).count();
+  CHECK(verified.fault == MachineFault::Timeout);
+  CHECK(waited_ms < 500.0);  // the reply bound (50 ms), not the caller's second
+  CHECK(bench.link.status().state == MachineState::Fault);
+  CHECK(bench.link.move(target(1, 0, 0, {0, 1, 2}, false), bench.in(200 * kMs)).refusal == MachineRefusal::Faulted);
+}
+
+TEST(Cy545Link, GarbageInAReplyIsAFaultNamingTheByte) {
+  Bench bench;
+  bench.start_and_home();
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_replies_garbled(true);
+    return 0;
+  });
+  CHECK(bench.link.verify(bench.in(500 * kMs)).fault == MachineFault::GarbledReply);
+  STRCMP_CONTAINS("byte 0", bench.link.last_error());
+}
+
+TEST(Cy545Link, APositionOtherThanTheCommandedOneIsAFault) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.move(target(5, 0, 0, {0, 1, 2}, false), bench.in(200 * kMs)).done);
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_reported_position_offset(3);
+    return 0;
+  });
+  CHECK(bench.link.verify(bench.in(500 * kMs)).fault == MachineFault::PositionMismatch);
+  STRCMP_CONTAINS("5 was commanded", bench.link.last_error());
+}
+
+TEST(Cy545Link, APortClosedMidJobIsAFault) {
+  Bench bench;
+  bench.start_and_home();
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.close_pty();
+    return 0;
+  });
+  const MachineResult verified = bench.link.verify(bench.in(500 * kMs));
+  CHECK(verified.fault == MachineFault::PortClosed);
+  CHECK(bench.link.status().fault == MachineFault::PortClosed);
+}
+
+TEST(Cy545Link, StartUpGivesUpWhenTheControllerNeverAnswers) {
+  Cy545Config config = fast_homing_config();
+  config.start_attempts = 5;
+  Bench bench(config);
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_replies_suppressed(true);
+    return 0;
+  });
+  const MachineResult started = bench.link.start(bench.in(2000 * kMs));
+  CHECK(started.fault == MachineFault::NoAnswer);
+  STRCMP_CONTAINS("never answered", bench.link.last_error());
+}
+
+TEST(Cy545Link, APathThatIsNotASerialPortIsRefusedByName) {
+  SerialPort port;
+  char error[256] = {};
+  CHECK_FALSE(port.open("/dev/null", error));
+  STRCMP_CONTAINS("/dev/null: not a serial port", error);
+  char file[] = "/tmp/stencil-not-a-tty-XXXXXX";
+  const int fd = mkstemp(file);
+  CHECK(fd >= 0);
+  close(fd);
+  CHECK_FALSE(port.open(file, error));
+  STRCMP_CONTAINS("not a serial port", error);
+  unlink(file);
+  CHECK_FALSE(port.open("/dev/no-such-port", error));
+  STRCMP_CONTAINS("/dev/no-such-port: cannot open", error);
+}
+
+TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
+  // A scripted peer: a pty whose master only records what the driver writes.
+  const int master = posix_openpt(O_RDWR | O_NOCTTY);
+  CHECK(master >= 0);
+  CHECK(grantpt(master) == 0 && unlockpt(master) == 0);
+  SerialPort port;
+  char error[256] = {};
+  CHECK_TEXT(port.open(ptsname(master), error), error);
+  CHECK_FALSE(port.has_modem_lines());
+  posix_clock::MonotonicClock clock;
+  Cy545Link link(port, clock, Cy545Config{});
+  CHECK(link.declare_home(clock.now_ns() + 100 * kMs).refusal == MachineRefusal::NotHomed);  // not started
+  char buffer[256];
+  // The peer answers the start-up query, recording what came before it.
+  std::string start_up;
+  std::thread peer([&]() {
+    while (start_up.find("? P\r") == std::string::npos) {
+      pollfd request{master, POLLIN, 0};
+      if (poll(&request, 1, 2000) <= 0) {
+        return;
+      }
+      const ssize_t n = read(master, buffer, sizeof buffer);
+      if (n <= 0) {
+        return;
+      }
+      start_up.append(buffer, static_cast<std::size_t>(n));
+    }
+    CHECK(write(master, "P=0\r", 4) == 4);
+  });
+  const MachineResult started = link.start(clock.now_ns() + 1000 * kMs);
+  peer.join();
+  CHECK_TEXT(started.done, link.last_error());
+  STRCMP_EQUAL("\r? P\r", start_up.c_str());
+  CHECK(link.declare_home(clock.now_ns() + 100 * kMs).done);
+  const auto take = [&]() {
+    std::string got;
+    pollfd request{master, POLLIN, 0};
+    while (poll(&request, 1, 20) > 0) {
+      const ssize_t n = read(master, buffer, sizeof buffer);
+      if (n <= 0) {
+        break;
+      }
+      got.append(buffer, static_cast<std::size_t>(n));
+    }
+    return got;
+  };
+  STRCMP_EQUAL("I\rR 1000\rF 1000\rS 0\rO 0\rA 0\r", take().c_str());
+  CHECK(link.move(target(5, -3, 2, {2, 0, 1}, false), clock.now_ns() + 500 * kMs).done);
+  STRCMP_EQUAL(
+      "B 49H\rB 7H\r/B 7\rN 2\r+\rG\r"   // z first: channel 2, 2 steps up
+      "B 41H\rB 7H\r/B 7\rN 5\r+\rG\r"   // then x: channel 0, 5 up
+      "B 45H\rB 7H\r/B 7\rN 3\r-\rG\r",  // then y: channel 1, 3 down
+      take().c_str());
+  CHECK(link.move(target(9, -3, 2, {0, 1, 2}, false), clock.now_ns() + 500 * kMs).done);
+  STRCMP_EQUAL("B 41H\rB 7H\r/B 7\rN 4\r+\rG\r", take().c_str());  // x again: its channel again
+  close(master);
+}
+
+TEST(Cy545Link, MeasuresTheLinksThroughputAgainstTheFake) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  const std::uint64_t bytes_before = bench.link.status().bytes_sent;
+  const int updates = 60;
+  const auto begin = std::chrono::steady_clock::now();
+  for (int i = 1; i <= updates; ++i) {
+    // A diagonal move at the mill's full rate: 11 steps on each axis, 33 in all (one update's worth).
+    const std::int32_t s = (i % 2) * 11;
+    const MachineResult moved = bench.link.move(target(s, s, s), bench.in(500 * kMs));
+    CHECK_TEXT(moved.done, bench.link.last_error());
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+  const double bytes_per_update = static_cast<double>(bench.link.status().bytes_sent - bytes_before) / updates;
+  std::printf("\n  CY545 link against the fake: %.1f updates/s, %.1f bytes per update (3 axes, 33 steps)\n",
+              updates / seconds, bytes_per_update);
+  CHECK(bench.link.verify(bench.in(200 * kMs)).done);
+}
