@@ -116,6 +116,9 @@ ReplyParse parse_reply(std::string_view bytes, char letter) {
     result.expected = expected;
     return result;
   };
+  if (std::string_view("APNRFSOB").find(letter) == std::string_view::npos) {
+    return garbled(0, "a reply to a query of a register the chip has");  // the caller's mistake, refused
+  }
   if (bytes.empty()) {
     return result;
   }

@@ -105,6 +105,7 @@ TEST(Cy545Commands, AGarbledReplyNamesTheByteAndWhatWasExpected) {
   CHECK_EQUAL(2U, r.at);
   CHECK(parse_reply("P=16777216\r", 'P').status == ReplyStatus::Garbled);  // beyond 24 bits
   CHECK(parse_reply("P=000000001\r", 'P').status == ReplyStatus::Garbled);  // too many digits
+  CHECK(parse_reply("\r=083806", '\r').status == ReplyStatus::Garbled);  // not a register: found by the fuzzer
   const char high_bit[] = {static_cast<char>('P' | 0x80), '=', '1', '\r'};
   CHECK(parse_reply({high_bit, 4}, 'P').status == ReplyStatus::Garbled);
 }

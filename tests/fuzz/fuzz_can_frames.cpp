@@ -1,0 +1,45 @@
+// libFuzzer target: the CAN frame decoders on both sides take any sequence of frames, refuse what
+// is bad, and never hand out a pose or command beyond the ranges.
+#include <linux/can.h>
+
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+
+#include "hal/haptic_device.hpp"
+#include "hal/socketcan/can_codec.hpp"
+
+namespace {
+void require(bool promise) {
+  if (!promise) {
+    __builtin_trap();
+  }
+}
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using namespace stencil::hal;
+  using namespace stencil::hal::socketcan;
+  HostFrameAssembler host(kDefaultHapticRange);
+  DeviceFrameAssembler device;
+  for (std::size_t offset = 0; offset + sizeof(can_frame) <= size; offset += sizeof(can_frame)) {
+    can_frame frame{};
+    std::memcpy(&frame, data + offset, sizeof frame);
+    const FrameResult from_device = host.accept(frame);
+    if (from_device.effect == FrameEffect::Completed) {
+      const PoseWire& pose = host.latest_pose();
+      for (int axis = 0; axis < 3; ++axis) {
+        require(std::abs(pose.position_um[axis]) <= static_cast<std::int32_t>(kDefaultHapticRange.position_limit_mm[axis] * 1000.0));
+      }
+    }
+    const FrameResult from_host = device.accept(frame);
+    if (from_host.effect == FrameEffect::Completed) {
+      const CommandWire& command = device.latest_command();
+      for (int axis = 0; axis < 3; ++axis) {
+        require(std::abs(command.force_mn[axis]) <= static_cast<int>(kDefaultHapticRange.force_limit_n * 1000.0));
+      }
+    }
+  }
+  return 0;
+}
