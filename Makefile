@@ -40,7 +40,7 @@ rt: deps
 	cmake --preset rt-x86_64
 	cmake --build --preset rt-x86_64
 
-# Each fuzz target runs for FUZZ_SECONDS (both at once, one per core): `make fuzz FUZZ_SECONDS=600` for a long run.
+# Each fuzz target runs for FUZZ_SECONDS (two at once, one per core): `make fuzz FUZZ_SECONDS=600` for a long run.
 FUZZ_SECONDS ?= 60
 fuzz: deps
 	cmake --preset fuzz -DSTENCIL_FUZZ_SECONDS=$(FUZZ_SECONDS)
