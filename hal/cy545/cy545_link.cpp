@@ -41,23 +41,88 @@ MachineResult Cy545Link::fail(MachineFault fault) {
 
 MachineResult Cy545Link::refuse(MachineRefusal refusal) const { return {false, refusal, MachineFault::None}; }
 
+void Cy545Link::started_running(MonotonicNs shortest_ns, MonotonicNs longest_ns) {
+  const MonotonicNs now = clock_.now_ns();
+  busy_until_ns_ = now + shortest_ns;
+  busy_bound_ns_ = now + longest_ns;
+  running_ = true;
+}
+
+// The chip reads nothing while it steps, and only three characters wait in its buffer. Once the
+// move's computed time has passed, the driver asks "? P" and sends carriage returns until the
+// answer comes: the three characters fit the buffer even if the chip is still busy, surplus
+// carriage returns are dropped (buffer full) or are empty lines (no effect), and the answer, which
+// can only come once the chip is free, also says whether it made every step. So no command ever
+// meets a busy chip, however late the chip (or, on a pseudo-terminal, the process playing it) runs.
 bool Cy545Link::wait_free(MonotonicNs deadline_ns) {
+  if (!running_) {
+    return true;
+  }
   if (busy_until_ns_ > deadline_ns) {
     clock_.sleep_until_ns(deadline_ns);
     return false;
   }
-  if (busy_until_ns_ > clock_.now_ns()) {
-    clock_.sleep_until_ns(busy_until_ns_);
-  }
-  return true;
-}
-
-bool Cy545Link::send(const CommandBytes& command, MonotonicNs deadline_ns) {
-  if (!wait_free(deadline_ns)) {
+  clock_.sleep_until_ns(busy_until_ns_);
+  running_ = false;  // the probe below must not wait for itself
+  port_.discard_input();
+  CommandBytes probe{};
+  static_cast<void>(query_command('P', probe));
+  if (!write_bytes(std::string_view(probe.view().data(), probe.size - 1), deadline_ns)) {  // "? P", no CR yet
     return false;
   }
-  const PortIo io = port_.write_all(command.view(), deadline_ns, clock_);
-  bytes_sent_ += command.size;
+  const MonotonicNs give_up = std::min(deadline_ns, busy_bound_ns_ + config_.reply_timeout_ns);
+  char reply[32];
+  std::size_t size = 0;
+  std::size_t kept = 0;
+  while (true) {
+    if (!write_bytes("\r", deadline_ns)) {
+      return false;
+    }
+    const MonotonicNs now = clock_.now_ns();
+    if (now >= give_up) {
+      if (give_up == deadline_ns && deadline_ns < busy_bound_ns_ + config_.reply_timeout_ns) {
+        running_ = true;  // the caller's bound ran out first: still unconfirmed, no fault
+        return false;
+      }
+      std::snprintf(last_error_, sizeof last_error_,
+                    "the controller did not report back within %lld ms of a move's end",
+                    static_cast<long long>(config_.reply_timeout_ns / 1'000'000));
+      latch_fault(MachineFault::Timeout);
+      return false;
+    }
+    // A long seek is asked about less often than a short move.
+    const MonotonicNs interval = std::max(config_.probe_interval_ns, (busy_bound_ns_ - busy_until_ns_) / 50);
+    const PortIo io = port_.read_line(reply + kept, sizeof reply - kept, size, std::min(give_up, now + interval), clock_);
+    bytes_received_ += size;
+    kept += size;
+    if (io == PortIo::Closed) {
+      latch_fault(MachineFault::PortClosed);
+      return false;
+    }
+    if (io == PortIo::TimedOut) {
+      continue;
+    }
+    const ReplyParse parsed = parse_reply({reply, kept}, 'P');
+    if (io != PortIo::Ok || parsed.status != ReplyStatus::Complete) {
+      const unsigned byte = parsed.at < kept ? static_cast<unsigned char>(reply[parsed.at]) : 0U;
+      std::snprintf(last_error_, sizeof last_error_, "reply to \"? P\": byte %zu is 0x%02X where %s was expected",
+                    parsed.at, byte, parsed.status == ReplyStatus::Garbled ? parsed.expected : "a reply");
+      latch_fault(MachineFault::GarbledReply);
+      return false;
+    }
+    if (parsed.value != position_register_) {
+      std::snprintf(last_error_, sizeof last_error_, "the controller reports position %u, %u was commanded",
+                    parsed.value, position_register_);
+      latch_fault(MachineFault::PositionMismatch);
+      return false;
+    }
+    return true;
+  }
+}
+
+bool Cy545Link::write_bytes(std::string_view bytes, MonotonicNs deadline_ns) {
+  const PortIo io = port_.write_all(bytes, deadline_ns, clock_);
+  bytes_sent_ += bytes.size();
   switch (io) {
     case PortIo::Ok:
       return true;
@@ -70,6 +135,10 @@ bool Cy545Link::send(const CommandBytes& command, MonotonicNs deadline_ns) {
   }
   latch_fault(MachineFault::WriteFailed);
   return false;
+}
+
+bool Cy545Link::send(const CommandBytes& command, MonotonicNs deadline_ns) {
+  return wait_free(deadline_ns) && write_bytes(command.view(), deadline_ns);
 }
 
 bool Cy545Link::send_bits(std::uint8_t code, MonotonicNs deadline_ns) {
@@ -213,7 +282,8 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
       return {false, MachineRefusal::None, fault_};
     }
     selected_channel_ = -1;  // the address lines now carry the input's number
-    busy_until_ns_ = clock_.now_ns() + seek;
+    position_register_ = 0;  // where the seek leaves it
+    started_running(0, seek);
   }
   // Read strobe off, rates back, then the position must be the home's.
   std::uint32_t position = 1;
@@ -294,9 +364,10 @@ MachineResult Cy545Link::move(const MachineTarget& target, MonotonicNs deadline_
         !bare_command('G', command) || !send(command, deadline_ns)) {
       return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
     }
-    busy_until_ns_ = clock_.now_ns() + steps_time_ns(steps, config_.step_rate) + config_.pace_margin_ns;
     commanded_[axis] = target.motor_steps[axis];
     position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + delta) & kMax24;
+    const MonotonicNs leg = steps_time_ns(steps, config_.step_rate);
+    started_running(leg, leg + config_.pace_margin_ns);
   }
   ++moves_done_;
   // Done when the last leg has run: the next update starts from a free chip.

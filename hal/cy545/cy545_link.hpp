@@ -10,9 +10,9 @@
 //
 // The chip has a three-character input buffer and ignores input while a move runs, so nothing is
 // sent before the previous move is known to be over: on a real port CTS holds the bytes (the chip
-// drops CTS while busy) and the driver also waits the move's computed duration plus a margin; on a
-// pseudo-terminal (no modem lines) the computed wait is all there is, and verify() confirms with a
-// query. Homing: per axis, select the channel, put its home switch on the input line (B <61H + 4c>H:
+// drops CTS while busy); on either port the driver waits the move's computed time, then asks "? P"
+// and sends carriage returns until the answer comes (the three characters fit the buffer even if
+// the chip is still busy; see wait_free), which also checks every step was made. Homing: per axis, select the channel, put its home switch on the input line (B <61H + 4c>H:
 // read strobe on, input address c) and seek (H 11H: down into the switch, up until it opens). The
 // chip keeps one position register for every channel; the driver tracks it (relative moves add to
 // it) and compares it with "? P" in verify().
@@ -23,6 +23,7 @@
 
 #include <array>
 #include <cstdint>
+#include <string_view>
 
 #include "hal/clock.hpp"
 #include "hal/cy545/cy545_commands.hpp"
@@ -37,7 +38,8 @@ struct Cy545Config {
   std::int32_t homing_travel_steps = 40960;  // the longest seek of one axis (64 mm), bounds its wait
   double update_period_s = 1.0 / 30.0;       // a move that takes longer is refused
   MonotonicNs reply_timeout_ns = 50'000'000; // a query's answer
-  MonotonicNs pace_margin_ns = 2'000'000;    // added to every computed move time
+  MonotonicNs pace_margin_ns = 5'000'000;    // beyond its computed time a move is overdue (+ reply_timeout: a fault)
+  MonotonicNs probe_interval_ns = 1'000'000; // carriage returns while waiting for "? P" to be answered
   int start_attempts = 20;                   // carriage returns and queries at start-up
   std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
   std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
@@ -72,8 +74,12 @@ class Cy545Link final : public MachineLink {
   bool send_bits(std::uint8_t code, MonotonicNs deadline_ns);
   bool latch(MonotonicNs deadline_ns);  // write strobe up and down
   bool select_channel(std::uint8_t channel, MonotonicNs deadline_ns);
-  // Waits until the chip is free (the computed end of its move), but not past the deadline.
+  // A move or seek was sent: the chip is busy for at least shortest_ns and at most longest_ns.
+  void started_running(MonotonicNs shortest_ns, MonotonicNs longest_ns);
+  // Waits until the chip has answered that it is free and where it is (see the .cpp), but not past
+  // the deadline; a wrong position or no answer by the move's longest time is a fault.
   bool wait_free(MonotonicNs deadline_ns);
+  bool write_bytes(std::string_view bytes, MonotonicNs deadline_ns);
   bool query(char letter, std::uint32_t& value, MonotonicNs deadline_ns);
 
   SerialPort& port_;
@@ -88,7 +94,9 @@ class Cy545Link final : public MachineLink {
   bool spindle_on_ = false;
   bool drivers_on_ = false;
   bool homed_ = false;
-  MonotonicNs busy_until_ns_ = 0;
+  MonotonicNs busy_until_ns_ = 0;  // the running move's shortest end
+  MonotonicNs busy_bound_ns_ = 0;  // its longest
+  bool running_ = false;           // a move or seek was sent and not yet confirmed over
   std::uint64_t moves_done_ = 0;
   std::uint64_t bytes_sent_ = 0;
   std::uint64_t bytes_received_ = 0;

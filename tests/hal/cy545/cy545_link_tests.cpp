@@ -9,6 +9,9 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <atomic>
+#include <cstring>
+#include <mutex>
 #include <thread>
 
 #include "hal/cy545/cy545_link.hpp"
@@ -224,7 +227,8 @@ TEST(Cy545Link, APathThatIsNotASerialPortIsRefusedByName) {
 }
 
 TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
-  // A scripted peer: a pty whose master only records what the driver writes.
+  // A scripted peer: a pty whose master records what the driver writes and answers each "? P"
+  // with the next scripted position.
   const int master = posix_openpt(O_RDWR | O_NOCTTY);
   CHECK(master >= 0);
   CHECK(grantpt(master) == 0 && unlockpt(master) == 0);
@@ -235,49 +239,66 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
   posix_clock::MonotonicClock clock;
   Cy545Link link(port, clock, Cy545Config{});
   CHECK(link.declare_home(clock.now_ns() + 100 * kMs).refusal == MachineRefusal::NotHomed);  // not started
-  char buffer[256];
-  // The peer answers the start-up query, recording what came before it.
-  std::string start_up;
+  std::string recorded;
+  std::mutex recorded_mutex;
+  std::atomic<bool> done{false};
+  // Start-up, then after the legs z +2, x +5, y -3 and x +4 the register holds 2, 7, 4, 8.
   std::thread peer([&]() {
-    while (start_up.find("? P\r") == std::string::npos) {
+    const char* replies[] = {"P=0\r", "P=2\r", "P=7\r", "P=4\r", "P=8\r"};
+    std::size_t answered = 0;
+    std::size_t seen = 0;  // where in the whole stream the last answered query ended
+    std::string stream;    // everything, never cleared (take() clears `recorded`)
+    char buffer[256];
+    while (!done) {
       pollfd request{master, POLLIN, 0};
-      if (poll(&request, 1, 2000) <= 0) {
-        return;
+      if (poll(&request, 1, 10) <= 0) {
+        continue;
       }
-      const ssize_t n = read(master, buffer, sizeof buffer);
-      if (n <= 0) {
-        return;
-      }
-      start_up.append(buffer, static_cast<std::size_t>(n));
-    }
-    CHECK(write(master, "P=0\r", 4) == 4);
-  });
-  const MachineResult started = link.start(clock.now_ns() + 1000 * kMs);
-  peer.join();
-  CHECK_TEXT(started.done, link.last_error());
-  STRCMP_EQUAL("\r? P\r", start_up.c_str());
-  CHECK(link.declare_home(clock.now_ns() + 100 * kMs).done);
-  const auto take = [&]() {
-    std::string got;
-    pollfd request{master, POLLIN, 0};
-    while (poll(&request, 1, 20) > 0) {
       const ssize_t n = read(master, buffer, sizeof buffer);
       if (n <= 0) {
         break;
       }
-      got.append(buffer, static_cast<std::size_t>(n));
+      const std::lock_guard<std::mutex> lock(recorded_mutex);
+      recorded.append(buffer, static_cast<std::size_t>(n));
+      stream.append(buffer, static_cast<std::size_t>(n));
+      const std::size_t query = stream.find("? P\r", seen);
+      if (query != std::string::npos && answered < 5) {
+        seen = query + 4;
+        CHECK(write(master, replies[answered], std::strlen(replies[answered])) > 0);
+        ++answered;
+      }
     }
-    return got;
+  });
+  const auto take = [&]() {
+    usleep(20000);
+    const std::lock_guard<std::mutex> lock(recorded_mutex);
+    std::string got;
+    got.swap(recorded);
+    // Surplus carriage returns while the chip may still be busy are empty lines: no effect.
+    std::string collapsed;
+    for (const char c : got) {
+      if (!(c == '\r' && !collapsed.empty() && collapsed.back() == '\r')) {
+        collapsed.push_back(c);
+      }
+    }
+    return collapsed;
   };
-  STRCMP_EQUAL("I\rR 1000\rF 1000\rS 0\rO 0\rA 0\r", take().c_str());
-  CHECK(link.move(target(5, -3, 2, {2, 0, 1}, false), clock.now_ns() + 500 * kMs).done);
+  const MachineResult started = link.start(clock.now_ns() + 1000 * kMs);
+  CHECK_TEXT(started.done, link.last_error());
+  CHECK(link.declare_home(clock.now_ns() + 100 * kMs).done);
+  STRCMP_EQUAL("\r? P\rI\rR 1000\rF 1000\rS 0\rO 0\rA 0\r", take().c_str());
+  MachineResult moved = link.move(target(5, -3, 2, {2, 0, 1}, false), clock.now_ns() + 500 * kMs);
+  CHECK_TEXT(moved.done, link.last_error());
   STRCMP_EQUAL(
-      "B 49H\rB 7H\r/B 7\rN 2\r+\rG\r"   // z first: channel 2, 2 steps up
-      "B 41H\rB 7H\r/B 7\rN 5\r+\rG\r"   // then x: channel 0, 5 up
-      "B 45H\rB 7H\r/B 7\rN 3\r-\rG\r",  // then y: channel 1, 3 down
+      "B 49H\rB 7H\r/B 7\rN 2\r+\rG\r? P\r"   // z first: channel 2, 2 steps up, then is it done?
+      "B 41H\rB 7H\r/B 7\rN 5\r+\rG\r? P\r"   // then x: channel 0, 5 up
+      "B 45H\rB 7H\r/B 7\rN 3\r-\rG\r? P\r",  // then y: channel 1, 3 down
       take().c_str());
-  CHECK(link.move(target(9, -3, 2, {0, 1, 2}, false), clock.now_ns() + 500 * kMs).done);
-  STRCMP_EQUAL("B 41H\rB 7H\r/B 7\rN 4\r+\rG\r", take().c_str());  // x again: its channel again
+  moved = link.move(target(9, -3, 2, {0, 1, 2}, false), clock.now_ns() + 500 * kMs);
+  CHECK_TEXT(moved.done, link.last_error());
+  STRCMP_EQUAL("B 41H\rB 7H\r/B 7\rN 4\r+\rG\r? P\r", take().c_str());  // x again: its channel again
+  done = true;
+  peer.join();
   close(master);
 }
 
