@@ -12,7 +12,9 @@ namespace stencil::hal::pio_shared_memory {
 // True when every position and angle is finite and within the range.
 [[nodiscard]] inline bool sample_in_range(const HapticSample& sample, const HapticRange& range) {
   for (int axis = 0; axis < 3; ++axis) {
-    if (!(std::fabs(sample.position_mm[axis]) <= range.position_limit_mm[axis])) return false;
+    if (!(std::fabs(sample.position_mm[axis] - range.position_centre_mm[axis]) <= range.position_limit_mm[axis])) {
+      return false;
+    }
   }
   for (const double angle : sample.angles_rad) {
     if (!(std::fabs(angle) <= range.angle_limit_rad)) return false;

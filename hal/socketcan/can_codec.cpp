@@ -121,7 +121,7 @@ FrameResult HostFrameAssembler::accept(const can_frame& frame) {
   pose.angles_100urad[0] = get_i16(&frame.data[4]);
   pose.angles_100urad[1] = get_i16(&frame.data[6]);
   for (int axis = 0; axis < 3; ++axis) {
-    if (!(std::fabs(pose.position_um[axis] * 1e-3) <= range_.position_limit_mm[axis])) {
+    if (!(std::fabs(pose.position_um[axis] * 1e-3 - range_.position_centre_mm[axis]) <= range_.position_limit_mm[axis])) {
       return reject(FrameRejection::OutOfRange);
     }
   }

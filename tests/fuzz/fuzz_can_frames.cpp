@@ -30,7 +30,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (from_device.effect == FrameEffect::Completed) {
       const PoseWire& pose = host.latest_pose();
       for (int axis = 0; axis < 3; ++axis) {
-        require(std::abs(pose.position_um[axis]) <= static_cast<std::int32_t>(kDefaultHapticRange.position_limit_mm[axis] * 1000.0));
+        require(std::abs(pose.position_um[axis] * 1e-3 - kDefaultHapticRange.position_centre_mm[axis]) <=
+                kDefaultHapticRange.position_limit_mm[axis]);
       }
     }
     const FrameResult from_host = device.accept(frame);

@@ -8,6 +8,7 @@
 #include <thread>
 #include <vector>
 
+#include "hal/haptic_range_checks.hpp"
 #include "hal/pio_shared_memory/pio_device_side.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/seqlock.hpp"
@@ -403,4 +404,25 @@ TEST(PioHapticDevice, MeasuresTheReadAndWriteOfOneCycle) {
               durations_ns[kCycles / 2], kCycles);
   CHECK_EQUAL(kCycles, fresh);
   CHECK_EQUAL(kCycles, written);
+}
+
+TEST_GROUP(HapticRangeRules){};
+
+TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPastItsMargin) {
+  hal::HapticSample sample{};
+  const auto at = [&](double x, double y, double z) {
+    sample.position_mm[0] = x;
+    sample.position_mm[1] = y;
+    sample.position_mm[2] = z;
+    return pio::sample_in_range(sample, hal::kCornerOriginHapticRange);
+  };
+  CHECK_TRUE(at(0.0, 0.0, 0.0));
+  CHECK_TRUE(at(500.0, 250.0, 250.0));
+  CHECK_TRUE(at(-25.0, 275.0, 125.0));
+  CHECK_FALSE(at(525.001, 0.0, 0.0));
+  CHECK_FALSE(at(0.0, -25.001, 0.0));
+  CHECK_FALSE(at(0.0, 0.0, NAN));
+  CHECK_FALSE(pio::sample_in_range(sample, hal::kDefaultHapticRange));  // the centred reach says no to z NaN too
+  CHECK_TRUE(at(250.0, 125.0, 125.0));
+  CHECK_FALSE(pio::sample_in_range(sample, hal::HapticRange{{1.0, 1.0, 1.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}}));
 }

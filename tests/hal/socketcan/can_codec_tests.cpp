@@ -13,7 +13,7 @@ using namespace stencil::hal::socketcan;
 namespace {
 
 // A range wider than the wire, so the round trips reach the int24 limits.
-constexpr HapticRange kWideRange{{9000.0, 9000.0, 9000.0}, 4.0, 5.0, 200.0};
+constexpr HapticRange kWideRange{{9000.0, 9000.0, 9000.0}, 4.0, 5.0, 200.0, {0.0, 0.0, 0.0}};
 
 can_frame frame_of(canid_t id, std::initializer_list<std::uint8_t> bytes) {
   can_frame frame{};
@@ -125,6 +125,24 @@ TEST(CanCodec, APoseAtTheRangeLimitIsAcceptedAndOneStepBeyondIsRefused) {
   }
   CHECK_EQUAL(5U, host.rejections().of(FrameRejection::OutOfRange));
   CHECK_EQUAL(1, host.latest_pose().counter);  // none of them applied
+}
+
+TEST(CanCodec, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPastItsMargin) {
+  HostFrameAssembler host(kCornerOriginHapticRange);  // [0, 500] x [0, 250] x [0, 250] mm, 25 mm margin
+  can_frame pose_a;
+  can_frame pose_b;
+  CHECK_TRUE(encode_pose(PoseWire{1, {500000, 250000, 0}, {0, 0}}, pose_a, pose_b));
+  CHECK_EQUAL(FrameEffect::HalfHeld, host.accept(pose_a).effect);
+  CHECK_EQUAL(FrameEffect::Completed, host.accept(pose_b).effect);
+  CHECK_TRUE(encode_pose(PoseWire{2, {-25000, 275000, -25000}, {0, 0}}, pose_a, pose_b));
+  CHECK_EQUAL(FrameEffect::HalfHeld, host.accept(pose_a).effect);
+  CHECK_EQUAL(FrameEffect::Completed, host.accept(pose_b).effect);
+  for (const PoseWire& pose : {PoseWire{3, {525001, 0, 0}, {0, 0}}, PoseWire{4, {0, -25001, 0}, {0, 0}}}) {
+    CHECK_TRUE(encode_pose(pose, pose_a, pose_b));
+    CHECK_EQUAL(FrameEffect::HalfHeld, host.accept(pose_a).effect);
+    CHECK_EQUAL(FrameEffect::Rejected, host.accept(pose_b).effect);
+  }
+  CHECK_EQUAL(2, host.latest_pose().counter);
 }
 
 TEST(CanCodec, CommandRoundTripsAtTheDevicesLimits) {
