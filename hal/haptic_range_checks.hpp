@@ -7,7 +7,7 @@
 
 #include "hal/haptic_device.hpp"
 
-namespace stencil::hal::pio_shared_memory {
+namespace stencil::hal {
 
 // True when every position and angle is finite and within the range.
 [[nodiscard]] inline bool sample_in_range(const HapticSample& sample, const HapticRange& range) {
@@ -52,10 +52,24 @@ struct ClampedCommand {
   return out;
 }
 
+// What a write that went out reports, counted: refused (not finite: zero force, enable off was
+// sent instead), clamped, or as given. Shared by both backends.
+[[nodiscard]] inline WriteResult write_outcome(const ClampedCommand& clamped, HapticCounters& counters) {
+  if (!clamped.finite) {
+    ++counters.commands_rejected;
+    return {WriteStatus::Rejected, HapticFault::CommandNotFinite};
+  }
+  if (clamped.clamped) {
+    ++counters.commands_clamped;
+    return {WriteStatus::Clamped, HapticFault::None};
+  }
+  return {WriteStatus::Written, HapticFault::None};
+}
+
 // A clamped value in physical units times `units_per_value` (1000: N to mN), rounded toward zero so
 // a clamped magnitude never grows past its limit; the caller guarantees the product fits in int32.
 [[nodiscard]] inline std::int32_t to_units_toward_zero(double value, double units_per_value) {
   return static_cast<std::int32_t>(value * units_per_value);
 }
 
-}  // namespace stencil::hal::pio_shared_memory
+}  // namespace stencil::hal

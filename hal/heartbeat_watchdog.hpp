@@ -7,7 +7,7 @@
 
 #include "hal/clock.hpp"
 
-namespace stencil::hal::pio_shared_memory {
+namespace stencil::hal {
 
 class HeartbeatWatchdog {
  public:
@@ -42,4 +42,4 @@ class HeartbeatWatchdog {
   bool started_ = false;
 };
 
-}  // namespace stencil::hal::pio_shared_memory
+}  // namespace stencil::hal

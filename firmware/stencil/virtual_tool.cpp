@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "firmware/stencil/move_limit.hpp"
 #include "firmware/stencil/sweep.hpp"
 
 namespace stencil::engine {
@@ -17,21 +18,6 @@ VirtualTool::VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& 
 void VirtualTool::limit_speed(double max_axis_move_mm, double max_total_move_mm) {
   max_axis_move_ = max_axis_move_mm;
   max_total_move_ = max_total_move_mm;
-}
-
-Eigen::Vector3d VirtualTool::within_speed(const Eigen::Vector3d& to, bool& limited) const {
-  const Eigen::Vector3d move = to - tip_;
-  const double largest = move.cwiseAbs().maxCoeff();
-  const double total = move.cwiseAbs().sum();
-  double scale = 1.0;
-  if (largest > max_axis_move_) {
-    scale = max_axis_move_ / largest;
-  }
-  if (total * scale > max_total_move_) {
-    scale = max_total_move_ / total;
-  }
-  limited = scale < 1.0;
-  return limited ? Eigen::Vector3d(tip_ + scale * move) : to;
 }
 
 Eigen::Vector3d VirtualTool::clamp_to_box(const Eigen::Vector3d& tip) const {
@@ -79,7 +65,8 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
   }
   const SweepResult sweep = check_sweep(part_, tip_, candidate, sweep_step_, kMaxSweepSteps);
   // Every point between the tip and `reached` was checked, so a shorter move along it is legal too.
-  const Eigen::Vector3d reached = within_speed(sweep.reached_mm, result.speed_limited);
+  const Eigen::Vector3d reached =
+      shorten_move(tip_, sweep.reached_mm, max_axis_move_, max_total_move_, result.speed_limited);
   result.sweep_steps = sweep.steps;
   switch (sweep.status) {
     case SweepStatus::Fault:

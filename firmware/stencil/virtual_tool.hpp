@@ -63,7 +63,6 @@ class VirtualTool {
 
  private:
   [[nodiscard]] Eigen::Vector3d clamp_to_box(const Eigen::Vector3d& tip) const;
-  [[nodiscard]] Eigen::Vector3d within_speed(const Eigen::Vector3d& to, bool& limited) const;
 
   const tables::PartTables& part_;
   Eigen::Vector3d tip_;

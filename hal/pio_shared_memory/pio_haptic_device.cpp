@@ -90,15 +90,7 @@ WriteResult PioHapticDevice::write_command(const HapticCommand& command) {
   words.host_heartbeat = ++host_heartbeat_;
   seqlock_write(window_->command, words);
 
-  if (!clamped.finite) {
-    ++counters_.commands_rejected;
-    return {WriteStatus::Rejected, HapticFault::CommandNotFinite};
-  }
-  if (clamped.clamped) {
-    ++counters_.commands_clamped;
-    return {WriteStatus::Clamped, HapticFault::None};
-  }
-  return {WriteStatus::Written, HapticFault::None};
+  return write_outcome(clamped, counters_);
 }
 
 }  // namespace stencil::hal::pio_shared_memory

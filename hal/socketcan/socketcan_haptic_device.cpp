@@ -98,17 +98,17 @@ WriteResult SocketCanHapticDevice::write_command(const HapticCommand& command) {
   // Never more than the device accepts, whatever the range says.
   const double force_limit_n = std::min(range_.force_limit_n, kForceLimitMn * 1e-3);
   const double torque_limit_nmm = std::min(range_.torque_limit_nmm, kTorqueLimitUnits * kTorqueNmmPerUnit);
-  const pio_shared_memory::ClampedCommand clamped =
-      pio_shared_memory::clamp_command(command, force_limit_n, torque_limit_nmm);
+  const ClampedCommand clamped =
+      clamp_command(command, force_limit_n, torque_limit_nmm);
 
   CommandWire wire{};
   wire.counter = static_cast<std::uint8_t>(command.cycle_counter & 0xFFU);
   for (int axis = 0; axis < 3; ++axis) {
-    wire.force_mn[axis] = static_cast<std::int16_t>(pio_shared_memory::to_units_toward_zero(clamped.force_n[axis], 1e3));
+    wire.force_mn[axis] = static_cast<std::int16_t>(to_units_toward_zero(clamped.force_n[axis], 1e3));
   }
   for (int axis = 0; axis < 2; ++axis) {
     wire.torque_10mnmm[axis] = static_cast<std::int16_t>(
-        pio_shared_memory::to_units_toward_zero(clamped.torque_nmm[axis], 1.0 / kTorqueNmmPerUnit));
+        to_units_toward_zero(clamped.torque_nmm[axis], 1.0 / kTorqueNmmPerUnit));
   }
   wire.enable = clamped.finite && command.enable;
   wire.host_heartbeat = ++host_heartbeat_;
@@ -123,15 +123,7 @@ WriteResult SocketCanHapticDevice::write_command(const HapticCommand& command) {
     return write_fault(sent == TransferStatus::WouldBlock ? HapticFault::TransportFull : HapticFault::TransportError);
   }
 
-  if (!clamped.finite) {
-    ++counters_.commands_rejected;
-    return {WriteStatus::Rejected, HapticFault::CommandNotFinite};
-  }
-  if (clamped.clamped) {
-    ++counters_.commands_clamped;
-    return {WriteStatus::Clamped, HapticFault::None};
-  }
-  return {WriteStatus::Written, HapticFault::None};
+  return write_outcome(clamped, counters_);
 }
 
 }  // namespace stencil::hal::socketcan

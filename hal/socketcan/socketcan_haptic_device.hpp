@@ -47,7 +47,7 @@ class SocketCanHapticDevice final : public HapticDevice {
   CanChannel* channel_;
   HapticRange range_;
   HostFrameAssembler assembler_;
-  pio_shared_memory::HeartbeatWatchdog device_watchdog_;
+  HeartbeatWatchdog device_watchdog_;
   HapticLinkState state_;
   HapticFault latched_fault_ = HapticFault::None;
   HapticCounters counters_{};

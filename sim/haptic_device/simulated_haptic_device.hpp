@@ -62,7 +62,7 @@ class SimulatedHapticDevice {
   DeviceSideLink& link_;
   PoseSource source_;
   mutable std::mutex mutex_;
-  hal::pio_shared_memory::HeartbeatWatchdog host_watchdog_;
+  hal::HeartbeatWatchdog host_watchdog_;
   DeviceCommand command_{};
   bool have_command_ = false;
   bool frozen_ = false;

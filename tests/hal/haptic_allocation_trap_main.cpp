@@ -15,34 +15,7 @@
 #include "sim/haptic_device/simulated_haptic_device.hpp"
 #include "tests/hal/pio_shared_memory/window_pair.hpp"
 #include "tests/sim/haptic_device/counter_pose.hpp"
-
-namespace {
-bool armed = false;
-unsigned long trapped = 0;
-void note(const char* what) {
-  if (armed) {
-    ++trapped;
-    armed = false;  // report once, without recursing through stdio's own allocations
-    std::fprintf(stderr, "haptic_allocation_trap: %s called inside the cycle's haptic calls\n", what);
-    armed = true;
-  }
-}
-}  // namespace
-
-extern "C" {
-void* __real_malloc(std::size_t);
-void* __real_calloc(std::size_t, std::size_t);
-void* __real_realloc(void*, std::size_t);
-void __real_free(void*);
-void* __wrap_malloc(std::size_t size) { note("malloc"); return __real_malloc(size); }
-void* __wrap_calloc(std::size_t count, std::size_t size) { note("calloc"); return __real_calloc(count, size); }
-void* __wrap_realloc(void* pointer, std::size_t size) { note("realloc"); return __real_realloc(pointer, size); }
-void __wrap_free(void* pointer) { note("free"); __real_free(pointer); }
-void* __real__Znwm(std::size_t);
-void* __real__Znam(std::size_t);
-void* __wrap__Znwm(std::size_t size) { note("operator new"); return __real__Znwm(size); }
-void* __wrap__Znam(std::size_t size) { note("operator new[]"); return __real__Znam(size); }
-}
+#include "tests/support/heap_trap.hpp"
 
 namespace {
 
@@ -55,11 +28,11 @@ unsigned long run(stencil::hal::HapticDevice& host, stencil::sim::SimulatedHapti
     const stencil::hal::MonotonicNs now = i * kMs;
     device.step(now);
     stencil::hal::HapticSample sample{};
-    armed = true;
+    stencil::test::arm_heap_trap("haptic_allocation_trap");
     const stencil::hal::ReadResult read = host.read_sample(now, sample);
     const stencil::hal::WriteResult written =
         host.write_command({{0.5, -0.25, 1.0}, {10.0, -5.0}, static_cast<std::uint32_t>(i), true});
-    armed = false;
+    stencil::test::disarm_heap_trap();
     fresh += read.status == stencil::hal::ReadStatus::Fresh ? 1 : 0;
     if (written.status == stencil::hal::WriteStatus::Fault) {
       std::fprintf(stderr, "haptic_allocation_trap: a write failed at cycle %d\n", i);
@@ -103,10 +76,10 @@ int main() {
   hal::socketcan::SocketCanHapticDevice can_host(&host_channel, hal::kDefaultHapticRange);
   const unsigned long can_fresh = run(can_host, can_device, cycles);
 
-  const bool ok = trapped == 0 && pio_fresh > cycles / 2 && can_fresh > cycles / 2;
+  const bool ok = stencil::test::trapped_heap_calls() == 0 && pio_fresh > cycles / 2 && can_fresh > cycles / 2;
   std::printf("haptic_allocation_trap: %d cycles per backend, %lu / %lu fresh samples (PIO / CAN), %lu heap calls "
               "inside the host's calls\n",
-              cycles, pio_fresh, can_fresh, trapped);
+              cycles, pio_fresh, can_fresh, stencil::test::trapped_heap_calls());
   std::printf("%d passed, %d failed\n", ok ? 1 : 0, ok ? 0 : 1);
   return ok ? 0 : 1;
 }

@@ -11,34 +11,7 @@
 #include "firmware/stencil/virtual_tool.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
-
-namespace {
-bool armed = false;
-unsigned long trapped = 0;
-void note(const char* what) {
-  if (armed) {
-    ++trapped;
-    armed = false;  // report once, without recursing through stdio's own allocations
-    std::fprintf(stderr, "allocation_trap: %s called inside the cycle\n", what);
-    armed = true;
-  }
-}
-}  // namespace
-
-extern "C" {
-void* __real_malloc(std::size_t);
-void* __real_calloc(std::size_t, std::size_t);
-void* __real_realloc(void*, std::size_t);
-void __real_free(void*);
-void* __wrap_malloc(std::size_t size) { note("malloc"); return __real_malloc(size); }
-void* __wrap_calloc(std::size_t count, std::size_t size) { note("calloc"); return __real_calloc(count, size); }
-void* __wrap_realloc(void* pointer, std::size_t size) { note("realloc"); return __real_realloc(pointer, size); }
-void __wrap_free(void* pointer) { note("free"); __real_free(pointer); }
-void* __real__Znwm(std::size_t);
-void* __real__Znam(std::size_t);
-void* __wrap__Znwm(std::size_t size) { note("operator new"); return __real__Znwm(size); }
-void* __wrap__Znam(std::size_t size) { note("operator new[]"); return __real__Znam(size); }
-}
+#include "tests/support/heap_trap.hpp"
 
 int main() {
   using namespace stencil;
@@ -59,7 +32,7 @@ int main() {
   std::mt19937_64 random(61);
   std::uniform_real_distribution<double> x(5.0, 45.0), y(2.0, 23.0), z(-1.0, 10.0);
   unsigned long cycles = 0;
-  armed = true;
+  stencil::test::arm_heap_trap("allocation_trap");
   for (int i = 0; i < 5000; ++i) {
     const Eigen::Vector3d desired(x(random), y(random), z(random));
     const engine::ContactResult contact = engine::query_contacts(part, {desired, Eigen::Vector3d::UnitZ()}, parameters);
@@ -68,7 +41,8 @@ int main() {
     static_cast<void>(engine::haptic_output(desired, result.tip_mm, contact, limits));
     ++cycles;
   }
-  armed = false;
+  stencil::test::disarm_heap_trap();
+  const unsigned long trapped = stencil::test::trapped_heap_calls();
   std::printf("allocation_trap: %lu cycles, %lu heap calls inside them, %zu triangles touched\n", cycles, trapped,
               touched.count());
   std::printf("%lu passed, %lu failed\n", trapped == 0 ? 1ul : 0ul, trapped == 0 ? 0ul : 1ul);

@@ -414,7 +414,7 @@ TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPa
     sample.position_mm[0] = x;
     sample.position_mm[1] = y;
     sample.position_mm[2] = z;
-    return pio::sample_in_range(sample, hal::kCornerOriginHapticRange);
+    return hal::sample_in_range(sample, hal::kCornerOriginHapticRange);
   };
   CHECK_TRUE(at(0.0, 0.0, 0.0));
   CHECK_TRUE(at(500.0, 250.0, 250.0));
@@ -422,7 +422,7 @@ TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPa
   CHECK_FALSE(at(525.001, 0.0, 0.0));
   CHECK_FALSE(at(0.0, -25.001, 0.0));
   CHECK_FALSE(at(0.0, 0.0, NAN));
-  CHECK_FALSE(pio::sample_in_range(sample, hal::kDefaultHapticRange));  // the centred reach says no to z NaN too
+  CHECK_FALSE(hal::sample_in_range(sample, hal::kDefaultHapticRange));  // the centred reach says no to z NaN too
   CHECK_TRUE(at(250.0, 125.0, 125.0));
-  CHECK_FALSE(pio::sample_in_range(sample, hal::HapticRange{{1.0, 1.0, 1.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}}));
+  CHECK_FALSE(hal::sample_in_range(sample, hal::HapticRange{{1.0, 1.0, 1.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}}));
 }
