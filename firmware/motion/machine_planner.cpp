@@ -16,9 +16,6 @@ constexpr std::array<AxisOrder, 6> kOrders = {{{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, 
 // A leg moves one axis by at most one update's budget (tens of steps): a few sub-steps at most.
 constexpr int kMaxLegSubSteps = 64;
 
-// Going back this little on an axis is first tried as not going back at all (see grid_target).
-constexpr double kReversalDeadbandSteps = 4.0;
-
 int sign_of(std::int32_t value) { return value > 0 ? 1 : (value < 0 ? -1 : 0); }
 
 }  // namespace

@@ -15,6 +15,12 @@
 
 namespace stencil::motion {
 
+// Going back fewer steps than this on an axis is first tried as not going back at all (see
+// MachinePlanner::grid_target): the virtual tool trembles by micrometres against a wall, and each
+// reversal costs a backlash take-up. So a held axis may end up to this many steps (plus one of
+// rounding) from the virtual tool.
+inline constexpr double kReversalDeadbandSteps = 4.0;
+
 struct PlannerLimits {
   MachineSpeed speed;
   double update_period_s;                     // one machine update (1/30 s on the rig)

@@ -86,20 +86,19 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             cover.deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm) {
           continue;
         }
-        load_leaf(part, node.first_point, node.point_count, leaf);
+        load_leaf(part, node.first_point, node.point_count, pose.tip_mm, leaf);
         bool finite = false;
         switch (cover.cover) {
           case geometry::BoxCover::Region:
           case geometry::BoxCover::RegionOrOutside:
-            finite = region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
-                                          pose.tip_mm, leaf);
+            finite = region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
             break;
           case geometry::BoxCover::SplitAtZ:
-            finite = split_leaf_contacts(tool, cover, pose.tip_mm, leaf);
+            finite = split_leaf_contacts(tool, cover, leaf);
             break;
           case geometry::BoxCover::Outside:  // skipped above
           case geometry::BoxCover::Mixed:
-            finite = mixed_leaf_contacts(tool, pose.tip_mm, leaf);
+            finite = mixed_leaf_contacts(tool, leaf);
             break;
         }
         if (!finite) {
@@ -177,31 +176,20 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     torque_sum += (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).cross(force);
     return true;
   };
-  // The same per point as visit_point, lane-wise over the leaf, sums included (their order is
+  // The same per point as visit_point, lane-wise over the leaf (single-precision sums in an order
   // fixed by the build, so the same inputs still give the same bits).
-  LeafForces forces;
   const auto visit_leaf = [&](const LeafContacts& leaf) {
-    // Depth is 0 in every lane that does not penetrate (padding included), so is its force.
-    const double deepest = leaf.depth.maxCoeff();
-    if (!(deepest > geometry::kSurfaceTolerance_mm)) {
+    if (leaf.penetrating == 0) {
       return true;
     }
-    std::uint32_t count = 0;
-    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
-      count += leaf.depth[lane] > geometry::kSurfaceTolerance_mm ? 1U : 0U;
+    result.penetrating_points += leaf.penetrating;
+    if (leaf.max_depth_mm > result.max_depth_mm) {
+      result.max_depth_mm = leaf.max_depth_mm;
+      result.deepest_point = leaf.first + leaf.deepest_lane;
     }
-    result.penetrating_points += count;
-    if (deepest > result.max_depth_mm) {
-      result.max_depth_mm = deepest;
-      std::uint32_t lane = 0;
-      while (lane + 1 < leaf.count && leaf.depth[lane] != deepest) {  // the first lane at the maximum
-        ++lane;
-      }
-      result.deepest_point = leaf.first + lane;
-    }
-    leaf_forces(leaf, k_world, centre, forces);
-    force_sum += Eigen::Vector3d(forces.fx.sum(), forces.fy.sum(), forces.fz.sum());
-    torque_sum += Eigen::Vector3d(forces.tx.sum(), forces.ty.sum(), forces.tz.sum());
+    const LeafForceSums sums = leaf_forces(leaf, k_world, parameters.compliance_centre_mm);
+    force_sum += sums.force;
+    torque_sum += sums.torque;
     return true;
   };
   const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);
@@ -226,7 +214,7 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
       [](std::uint32_t, const geometry::PointClassification& c) {
         return c.contact != geometry::PointContact::Penetrating;
       },
-      [](const LeafContacts& leaf) { return !(leaf.depth.maxCoeff() > geometry::kSurfaceTolerance_mm); });
+      [](const LeafContacts& leaf) { return leaf.penetrating == 0; });
   switch (walk) {
     case Walk::Finished:
       return Legality::Legal;

@@ -129,7 +129,10 @@ TEST(MillChain, TheMillFollowsTheVirtualToolRoundTheHexPrismThroughTheRealDriver
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
   CHECK_TEXT(link.verify(clock.now_ns() + 200 * kMs).done, link.last_error());
   const Eigen::Vector3d reached = motion::steps_to_world(frames, planner.axis_steps());
-  CHECK((reached - tool.tip_mm()).norm() < 0.003);  // within a couple of steps of the virtual tool
+  // Within a step of the virtual tool on each axis, or within the reversal deadband (and a step of
+  // rounding) where the planner held an axis rather than take up backlash for a tremor.
+  const double held_mm = (motion::kReversalDeadbandSteps + 1.0) / frames.steps_per_mm;
+  CHECK(((reached - tool.tip_mm()).cwiseAbs().array() <= held_mm).all());
   CHECK(worst_lag < 0.5);
   std::printf("\n  mill chain round the prism's vertex: %d updates (%d taking up backlash) in %.1f s = %.1f updates/s, "
               "%.1f bytes/update, worst lag %.3f mm\n",

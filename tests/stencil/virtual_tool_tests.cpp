@@ -125,8 +125,11 @@ TEST(VirtualTool, WithASpeedLimitItMovesNoFasterThanTheMillAndStaysLegal) {
     const Eigen::Vector3d before = tool.tip_mm();
     const RemediationResult result = tool.step({30.0, 14.0, 5.0}, ContactParameters{});
     const Eigen::Vector3d move = (tool.tip_mm() - before).cwiseAbs();
-    CHECK(move.maxCoeff() <= 0.0014 + 1e-15);
-    CHECK(move.sum() <= 0.0015 + 1e-15);
+    // Rounding slack: the tip's coordinates are tens of mm, whose last bit is about 4e-15 mm, and
+    // the move is rounded once going out and once measured back here.
+    constexpr double kRounding_mm = 1e-13;
+    CHECK(move.maxCoeff() <= 0.0014 + kRounding_mm);
+    CHECK(move.sum() <= 0.0015 + kRounding_mm);
     CHECK(check_legal(loaded.part, tool.pose()) == Legality::Legal);
     limited += result.speed_limited ? 1 : 0;
   }
