@@ -8,6 +8,30 @@
 #include "firmware/stencil/sweep.hpp"
 
 namespace stencil::engine {
+namespace {
+
+// How far to move along the reaction to clear the deepest point: its depth (and the clearance)
+// measured along the reaction, i.e. divided by the cosine between the reaction and the way that
+// point leaves the tool. Into a face the two agree (cosine 1: the depth itself); into a concave
+// corner the reaction is the bisector and the plain depth would clear each face by only cos 45
+// of it, so the slip would creep up on the surface over several re-queries. The cosine is taken no
+// lower than kMinSlipCosine, so a slip is never longer than twice the depth; the re-query decides.
+double slip_length_mm(const tables::PartTables& part, const Eigen::Vector3d& tip_mm, const ContactResult& contact,
+                      const Eigen::Vector3d& reaction) {
+  const double length = contact.max_depth_mm + kSlipClearance_mm;
+  const tables::PackedPoint& p = part.points[contact.deepest_point];
+  const geometry::PointClassification deepest =
+      geometry::classify_at_pose(part.tool, tip_mm, Eigen::Vector3d::UnitZ(), {p.x_mm, p.y_mm, p.z_mm});
+  // The tool moving along the reaction is the point moving against it: its depth falls at the rate
+  // -escape . reaction.
+  const double cosine = -deepest.escape_direction.dot(reaction);
+  if (deepest.contact != geometry::PointContact::Penetrating || !(cosine > kMinSlipCosine)) {
+    return length / kMinSlipCosine;
+  }
+  return length / cosine;
+}
+
+}  // namespace
 
 VirtualTool::VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm)
     : part_(part),
@@ -56,7 +80,9 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
     if (!(force > 0.0)) {
       break;  // no direction to slip in
     }
-    candidate = clamp_to_box(candidate + (contact.max_depth_mm + kSlipClearance_mm) / force * contact.force_n);
+    const Eigen::Vector3d reaction = contact.force_n / force;
+    const double slip = slip_length_mm(part_, candidate, contact, reaction);
+    candidate = clamp_to_box(candidate + slip * reaction);
     result.slip_iterations = iteration + 1;
   }
   if (!found) {

@@ -15,6 +15,7 @@ namespace stencil::engine {
 inline constexpr int kMaxSlipIterations = 8;
 inline constexpr int kMaxSweepSteps = 64;
 inline constexpr double kSlipClearance_mm = 0.001;  // a slip ends 1 um clear of the surface, not on it
+inline constexpr double kMinSlipCosine = 0.5;       // a slip is at most twice the depth (and the clearance)
 
 enum class RemediationStatus : std::uint8_t {
   Followed,      // the desired pose was legal and reached by a legal sweep

@@ -115,6 +115,25 @@ TEST(VirtualTool, SlipsAlongAFaceInsteadOfStickingAtTheEntryPoint) {
   CHECK(tool.tip_mm().z() <= 6.0 + 0.01);
 }
 
+TEST(VirtualTool, PushedIntoAConcaveCornerItSlipsOutToBothFacesWithinTwoSlips) {
+  // A slot wide enough for the 3 mm ball: its floor (z = 3) meets its wall (y = 9.5) in a corner.
+  const Loaded loaded(tablegen::slotted_block(30.0, 12.0, 6.0, 6.0, 3.0, 10.0, 6.5));
+  VirtualTool tool(loaded.part, {25.0, 12.5, 3.5});
+  // 0.5 mm into the floor and into the wall at once: the reaction is about the corner's bisector,
+  // and the slip clears the deepest point measured along it (0.5 / cos 45). Moving by 0.5 along
+  // it clears each face by only 0.35 mm at a time: three slips here, five in the bench's corner.
+  // The second slip mends what the reaction's lean towards one face left.
+  const RemediationResult result = tool.step({25.0, 10.5, 2.5}, ContactParameters{});
+  CHECK(result.status == RemediationStatus::Slipped);
+  CHECK(result.slip_iterations >= 1 && result.slip_iterations <= 2);
+  CHECK(check_legal(loaded.part, tool.pose()) == Legality::Legal);
+  CHECK(test::ball_end_gouge_mm(loaded.part, tool.tip_mm()) <= loaded.part.header.gouge_bound_mm + 1e-5);
+  // Resting against both faces: 1.5 mm (the ball's radius) from the wall, its tip on the floor.
+  DOUBLES_EQUAL(25.0, tool.tip_mm().x(), 1e-6);
+  DOUBLES_EQUAL(11.0, tool.tip_mm().y(), 0.01);
+  DOUBLES_EQUAL(3.0, tool.tip_mm().z(), 0.01);
+}
+
 TEST(VirtualTool, WithASpeedLimitItMovesNoFasterThanTheMillAndStaysLegal) {
   const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
   VirtualTool tool(loaded.part, {20.0, 12.5, 7.0});
