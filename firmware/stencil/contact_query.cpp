@@ -241,7 +241,7 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
       },
       [&](const LeafContacts& leaf) {
         for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-          if (leaf.in_tool[lane]) {
+          if ((leaf.in_tool >> lane) & 1U) {
             touched.insert(part.triangle_ids[leaf.first + lane]);
           }
         }

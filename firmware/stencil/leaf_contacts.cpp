@@ -3,6 +3,7 @@
 #include "firmware/stencil/leaf_contacts.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 #if defined(__AVX2__)
@@ -52,6 +53,37 @@ float lane_max(const LeafLanes& a) {
     best = std::max(best, partial[j]);
   }
   return best;
+}
+
+// Per-lane verdicts, -1 where true: what the vectorised compares write, packed into a LaneMask.
+using LaneFlags = std::array<std::int32_t, kLanes>;
+
+LaneMask pack(const LaneFlags& flags) {
+#if defined(__AVX2__)
+  LaneMask mask = 0;
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    const __m256 block = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(flags.data() + base)));
+    mask |= static_cast<LaneMask>(_mm256_movemask_ps(block)) << base;
+  }
+  return mask;
+#else
+  LaneMask mask = 0;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    mask |= flags[lane] != 0 ? LaneMask{1} << lane : 0U;
+  }
+  return mask;
+#endif
+}
+
+LaneMask lanes_below(std::uint32_t count) { return count >= kLanes ? ~LaneMask{0} : (LaneMask{1} << count) - 1U; }
+
+// Calls visit(lane) for each lane of the mask, lowest first.
+template <typename Visit>
+void for_each_lane(LaneMask mask, Visit&& visit) {
+  while (mask != 0) {
+    visit(static_cast<std::uint32_t>(std::countr_zero(mask)));
+    mask &= mask - 1U;
+  }
 }
 
 // The largest error of a float depth against the double one, for a leaf of this size and a
@@ -162,30 +194,33 @@ bool surface_contacts(const geometry::ImplicitSurface& surface, bool or_outside,
       return false;
   }
   const float band = band_for(leaf, surface);
-  std::uint32_t uncertain = 0;
+  LaneFlags penetrating, in_tool, uncertain;
   LeafLanes check;
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
     const float depth = -sign * f[lane];  // the interior distance to the region's surface
     leaf.depth[lane] = depth > kTolerance_mm ? depth : 0.0F;
+    penetrating[lane] = depth > kTolerance_mm ? -1 : 0;
     // Straddling the region's boundary, a point is in the tool exactly when the boundary test that
     // leads to the region passes: -tolerance <= that same interior distance.
-    leaf.in_tool[lane] = !or_outside || depth >= -kTolerance_mm;
-    uncertain += std::abs(depth) <= band ? 1U : 0U;
+    in_tool[lane] = !or_outside || depth >= -kTolerance_mm ? -1 : 0;
+    uncertain[lane] = std::abs(depth) <= band ? -1 : 0;
     check[lane] = f[lane] + leaf.ex[lane] + leaf.ey[lane] + leaf.ez[lane];
   }
   // An infinity or NaN anywhere makes the sum non-finite (inf - inf is NaN).
   if (!std::isfinite(lane_sum(check))) {
     return false;
   }
-  if (uncertain > 0) {
-    for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-      if (std::abs(-sign * f[lane]) <= band) {
-        const double depth = exact_depth(leaf, lane, surface);
-        leaf.depth[lane] = depth > geometry::kSurfaceTolerance_mm ? static_cast<float>(depth) : 0.0F;
-        leaf.in_tool[lane] = !or_outside || depth >= -geometry::kSurfaceTolerance_mm;
-      }
-    }
-  }
+  const LaneMask valid = lanes_below(leaf.count);
+  leaf.penetrating_lanes = pack(penetrating) & valid;
+  leaf.in_tool = pack(in_tool) & valid;
+  for_each_lane(pack(uncertain) & valid, [&](std::uint32_t lane) {
+    const double depth = exact_depth(leaf, lane, surface);
+    const LaneMask bit = LaneMask{1} << lane;
+    const bool deeper = depth > geometry::kSurfaceTolerance_mm;
+    leaf.depth[lane] = deeper ? static_cast<float>(depth) : 0.0F;
+    leaf.penetrating_lanes = deeper ? leaf.penetrating_lanes | bit : leaf.penetrating_lanes & ~bit;
+    leaf.in_tool = (!or_outside || depth >= -geometry::kSurfaceTolerance_mm) ? leaf.in_tool | bit : leaf.in_tool & ~bit;
+  });
   return true;
 }
 
@@ -194,38 +229,36 @@ void clear_contacts(LeafContacts& leaf) {
   leaf.ex.fill(0.0F);
   leaf.ey.fill(0.0F);
   leaf.ez.fill(0.0F);
-  leaf.in_tool.fill(false);
+  leaf.in_tool = 0;
+  leaf.penetrating_lanes = 0;
 }
 
-// Clears the lanes past count, counts the penetrating lanes and finds the deepest in double
-// precision: every lane whose float depth is within twice the band of the float maximum may be it.
-// exact(lane) gives a lane's double-precision depth.
+// Zeroes the depth past count (so sums may run over every lane), counts the penetrating lanes and
+// finds the deepest in double precision: every penetrating lane whose float depth is within twice
+// the band of the float maximum may be it. exact(lane) gives a lane's double-precision depth.
 template <typename ExactDepth>
 void summarise(float band, ExactDepth&& exact, LeafContacts& leaf) {
-  for (std::uint32_t lane = leaf.count; lane < kLanes; ++lane) {
-    leaf.depth[lane] = 0.0F;
-    leaf.in_tool[lane] = false;
-  }
-  std::uint32_t count = 0;
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
-    count += leaf.depth[lane] > 0.0F ? 1U : 0U;
+    leaf.depth[lane] = lane < leaf.count ? leaf.depth[lane] : 0.0F;
   }
-  leaf.penetrating = count;
+  leaf.penetrating = static_cast<std::uint32_t>(std::popcount(leaf.penetrating_lanes));
   leaf.max_depth_mm = 0.0;
   leaf.deepest_lane = 0;
-  if (count == 0) {
+  if (leaf.penetrating == 0) {
     return;
   }
   const float floor = lane_max(leaf.depth) - 2.0F * band;
-  for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-    if (leaf.depth[lane] > 0.0F && leaf.depth[lane] >= floor) {
-      const double depth = exact(lane);
-      if (depth > leaf.max_depth_mm) {
-        leaf.max_depth_mm = depth;
-        leaf.deepest_lane = lane;
-      }
-    }
+  LaneFlags near_deepest;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    near_deepest[lane] = leaf.depth[lane] >= floor ? -1 : 0;
   }
+  for_each_lane(pack(near_deepest) & leaf.penetrating_lanes, [&](std::uint32_t lane) {
+    const double depth = exact(lane);
+    if (depth > leaf.max_depth_mm) {
+      leaf.max_depth_mm = depth;
+      leaf.deepest_lane = lane;
+    }
+  });
 }
 
 // Widens `count` packed triples (x, y, z floats one after another) into three lanes, less
@@ -345,34 +378,35 @@ bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClass
   const geometry::ImplicitSurface* below = part_surface(tool, cover.below);
   const geometry::ImplicitSurface* above = part_surface(tool, cover.above);
   // classify_meridian's partition test, on the same double-precision z: below when z - split < 0.
-  std::array<bool, kLanes> is_below{};
+  LaneMask is_below = 0;
   for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-    is_below[lane] = exact_offset(leaf, lane).z - cover.split_z_mm < 0.0;
+    is_below |= exact_offset(leaf, lane).z - cover.split_z_mm < 0.0 ? LaneMask{1} << lane : 0U;
   }
   if (!part_contacts(below, cover.below, leaf)) {
     return false;
   }
   const LeafLanes depth = leaf.depth, ex = leaf.ex, ey = leaf.ey, ez = leaf.ez;
-  const std::array<bool, kLanes> in_tool = leaf.in_tool;
+  const LaneMask below_in_tool = leaf.in_tool, below_penetrating = leaf.penetrating_lanes;
   if (!part_contacts(above, cover.above, leaf)) {
     return false;
   }
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
-    if (is_below[lane]) {
+    if ((is_below >> lane) & 1U) {
       leaf.depth[lane] = depth[lane];
       leaf.ex[lane] = ex[lane];
       leaf.ey[lane] = ey[lane];
       leaf.ez[lane] = ez[lane];
-      leaf.in_tool[lane] = in_tool[lane];
     }
   }
+  leaf.in_tool = (below_in_tool & is_below) | (leaf.in_tool & ~is_below);
+  leaf.penetrating_lanes = (below_penetrating & is_below) | (leaf.penetrating_lanes & ~is_below);
   const float band = std::max(below != nullptr ? band_for(leaf, *below) : 0.0F,
                               above != nullptr ? band_for(leaf, *above) : 0.0F);
   // Only penetrating lanes are asked for, and those have a surface on their own side.
   summarise(
       band,
       [&](std::uint32_t lane) {
-        const geometry::ImplicitSurface* surface = is_below[lane] ? below : above;
+        const geometry::ImplicitSurface* surface = ((is_below >> lane) & 1U) != 0 ? below : above;
         return surface != nullptr ? exact_depth(leaf, lane, *surface) : 0.0;
       },
       leaf);
@@ -382,6 +416,9 @@ bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClass
 bool mixed_leaf_contacts(const geometry::ToolBsp& tool, LeafContacts& leaf) {
   LeafLanes r{}, radial{}, axial{};  // past count: zero, so no escape and no force
   std::array<double, kLanes> exact{};
+  leaf.depth.fill(0.0F);
+  leaf.in_tool = 0;
+  leaf.penetrating_lanes = 0;
   for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
     // No outline pre-filter here: it would drop points touching the surface from just outside,
     // which the settled leaves keep; the tool tree decides them all alike, in double precision.
@@ -394,7 +431,8 @@ bool mixed_leaf_contacts(const geometry::ToolBsp& tool, LeafContacts& leaf) {
     const bool inside = c.contact != geometry::PointContact::Outside;
     const bool penetrating = c.contact == geometry::PointContact::Penetrating;
     r[lane] = static_cast<float>(r_exact);
-    leaf.in_tool[lane] = inside;
+    leaf.in_tool |= inside ? LaneMask{1} << lane : 0U;
+    leaf.penetrating_lanes |= penetrating ? LaneMask{1} << lane : 0U;
     exact[lane] = penetrating ? c.depth_mm : 0.0;
     leaf.depth[lane] = penetrating ? static_cast<float>(c.depth_mm) : 0.0F;  // > 0: depth > 1e-9
     radial[lane] = inside ? static_cast<float>(c.escape.radial) : 0.0F;

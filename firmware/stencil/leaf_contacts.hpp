@@ -25,6 +25,8 @@ namespace stencil::engine {
 // the double-precision classification. Only the force and torque sums carry the float rounding
 // (relative error about 1e-6, far below anything the operator can feel).
 using LeafLanes = std::array<float, tables::kMaxLeafPoints>;
+using LaneMask = std::uint32_t;  // bit i for lane i
+static_assert(tables::kMaxLeafPoints <= 32, "a lane mask holds every lane of a leaf");
 
 // Below this length a point's normal and the tool's escape direction cancel: the point gives no
 // force direction (the same threshold for the per-point path of the query and the lanes).
@@ -47,8 +49,9 @@ struct LeafContacts {
   alignas(32) LeafLanes ex;     // escape direction in world frame; 0 for points outside the tool
   alignas(32) LeafLanes ey;
   alignas(32) LeafLanes ez;
-  std::array<bool, tables::kMaxLeafPoints> in_tool;  // touching or penetrating; false past count
-  std::uint32_t penetrating;  // lanes with depth > 0
+  LaneMask in_tool;            // lanes touching or penetrating; none past count
+  LaneMask penetrating_lanes;  // lanes with depth > 0
+  std::uint32_t penetrating;   // how many
   double max_depth_mm;        // the deepest lane's depth in double precision; 0 when none penetrates
   std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
 };
