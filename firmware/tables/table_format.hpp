@@ -32,8 +32,8 @@ inline constexpr std::size_t kCrcStartOffset = 20;
 // Capacities the controller reserves for (static storage), and the most the generator writes.
 inline constexpr std::uint32_t kMaxTablePoints = 4'194'304;     // 2^22
 inline constexpr std::uint32_t kMaxTableTriangles = 2'097'152;  // 2^21
-// A median-split tree with at most kMaxLeafPoints per leaf has leaves of at least 17 points, so
-// fewer than 2 * points / 16 nodes; a table may hold smaller leaves, up to this many nodes.
+// The generator's tree has full leaves of kMaxLeafPoints points but the last, so fewer than
+// 2 * points / 32 + 1 nodes; a table may hold smaller leaves, up to this many nodes.
 inline constexpr std::uint32_t kMaxTableNodes = kMaxTablePoints / 4;
 inline constexpr std::uint32_t kMaxLeafPoints = 32;
 // The loader walks the tree with a fixed stack: deeper trees are refused. A median split of

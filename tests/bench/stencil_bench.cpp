@@ -97,6 +97,7 @@ volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
 int main(int argc, char** argv) {
   bool json = false;
   bool references = true;
+  std::string only_state;  // empty: every state
   std::vector<std::size_t> sizes = {10'000, 100'000, 1'000'000};
   for (int i = 1; i < argc; ++i) {
     const std::string argument = argv[i];
@@ -108,13 +109,20 @@ int main(int argc, char** argv) {
       sizes = {1'000'000};
     } else if (argument == "--stencil-only") {
       references = false;
+    } else if (argument == "--state" && i + 1 < argc) {
+      only_state = argv[++i];
+      if (only_state != "free" && only_state != "light" && only_state != "deep" && only_state != "deep-corner") {
+        std::fprintf(stderr, "stencil-bench: --state %s: expected free, light, deep or deep-corner\n", only_state.c_str());
+        return 2;
+      }
     } else {
       std::printf(
-          "usage: stencil-bench [--json] [--quick | --large] [--stencil-only]\n"
+          "usage: stencil-bench [--json] [--quick | --large] [--stencil-only] [--state NAME]\n"
           "Times the collision query and the full cycle (query + remediation with sweep) on parts of\n"
           "1e4, 1e5 and 1e6 points (--quick: the first two) in free space, light contact (0.05 mm into a\n"
           "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
           "FCL. --large: only 1e6 points. --stencil-only: leave out brute force and FCL (for profiling).\n"
+          "--state free|light|deep|deep-corner: only that state (for profiling one case).\n"
           "--json: one JSON object per line.\n");
       return argument == "--help" || argument == "-h" ? 0 : 2;
     }
@@ -169,6 +177,9 @@ int main(int argc, char** argv) {
     };
 
     for (const State& state : states) {
+      if (!only_state.empty() && only_state != state.name) {
+        continue;
+      }
       const engine::ToolPose pose{state.desired, Eigen::Vector3d::UnitZ()};
       const Timing query = measure([&] { sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm; },
                                    5000, 2.0);

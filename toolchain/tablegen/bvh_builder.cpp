@@ -1,4 +1,5 @@
-// Median-split 14-DOP tree; node positions are known in advance, so subtrees build independently.
+// 14-DOP tree split at whole leaves near the median; node positions are known in advance, so
+// subtrees build independently.
 #include "toolchain/tablegen/bvh_builder.hpp"
 
 #include <algorithm>
@@ -58,7 +59,7 @@ class TreeBuilder {
         widest = slab;
       }
     }
-    const std::uint32_t middle = begin + (end - begin) / 2;
+    const auto middle = static_cast<std::uint32_t>(begin + point_tree_left_count(end - begin));
     const auto& direction = geometry::kKdopSlabDirections[widest];
     const auto key = [&](std::uint32_t index) {
       const tables::PackedPoint& point = points_[index];
@@ -80,12 +81,17 @@ class TreeBuilder {
 
 }  // namespace
 
+std::uint64_t point_tree_left_count(std::uint64_t count) {
+  const std::uint64_t leaves = (count + tables::kMaxLeafPoints - 1) / tables::kMaxLeafPoints;
+  return tables::kMaxLeafPoints * (leaves / 2);
+}
+
 std::uint64_t point_tree_node_count(std::uint64_t count) {
   if (count <= tables::kMaxLeafPoints) {
     return 1;
   }
-  const std::uint64_t half = count / 2;
-  return 1 + point_tree_node_count(half) + point_tree_node_count(count - half);
+  const std::uint64_t left = point_tree_left_count(count);
+  return 1 + point_tree_node_count(left) + point_tree_node_count(count - left);
 }
 
 PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsigned threads) {
