@@ -92,6 +92,26 @@ std::size_t brute_force(const tables::PartTables& part, const Eigen::Vector3d& t
 
 volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
 
+// The machine's own tail at a given length of work: a fixed chain of dependent arithmetic, as long
+// as `median_us`, timed the same way. On a shared or virtual machine the 99.9th percentile of any
+// work of tens of microseconds is inflated by interrupts and by the host taking the CPU away; this
+// row, in the same run, shows how much of a measured tail is the machine's rather than the code's.
+Timing baseline_of_length(double median_us) {
+  const auto chain = [](std::size_t steps) {
+    double value = sink;
+    for (std::size_t i = 0; i < steps; ++i) {
+      value = value * 0.999999 + 1e-9;
+    }
+    sink = value;
+  };
+  std::size_t steps = 1000;
+  for (int round = 0; round < 3; ++round) {  // calibrate on the median of short runs
+    const Timing t = measure([&] { chain(steps); }, 200, 0.5);
+    steps = std::max<std::size_t>(1, static_cast<std::size_t>(static_cast<double>(steps) * median_us / t.median_us));
+  }
+  return measure([&] { chain(steps); }, 5000, 2.0);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,6 +143,8 @@ int main(int argc, char** argv) {
           "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
           "FCL. --large: only 1e6 points. --stencil-only: leave out brute force and FCL (for profiling).\n"
           "--state free|light|deep|deep-corner: only that state (for profiling one case).\n"
+          "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
+          "timed the same way, so the machine's own tail can be told from the code's.\n"
           "--json: one JSON object per line.\n");
       return argument == "--help" || argument == "-h" ? 0 : 2;
     }
@@ -193,6 +215,7 @@ int main(int argc, char** argv) {
           },
           5000, 2.0);
       report_row(state, "stencil", "cycle", cycle);
+      report_row(state, "baseline", "cycle", baseline_of_length(cycle.median_us));
       if (!references) {
         continue;
       }
