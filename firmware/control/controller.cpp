@@ -1,0 +1,274 @@
+// The cycle: read -> check -> engine -> write -> hand off, and the latched safe state.
+#include "firmware/control/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stencil::control {
+namespace {
+
+constexpr double kNsPerS = 1e9;
+
+Eigen::Vector3d position_of(const hal::HapticSample& sample) {
+  return {sample.position_mm[0], sample.position_mm[1], sample.position_mm[2]};
+}
+
+void copy3(const Eigen::Vector3d& from, double (&to)[3]) {
+  to[0] = from.x();
+  to[1] = from.y();
+  to[2] = from.z();
+}
+
+}  // namespace
+
+Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device, const CycleRings& rings,
+                       const ControllerConfig& config)
+    : part_(part), device_(device), rings_(rings), config_(config), tool_(part, config.home_tip_mm) {
+  ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
+  last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
+}
+
+void Controller::write_zero_force() {
+  last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, static_cast<std::uint32_t>(cycle_), false};
+  static_cast<void>(device_.write_command(last_command_));
+}
+
+void Controller::enter_safe_state(SafeReason reason, hal::MonotonicNs now_ns) {
+  static_cast<void>(now_ns);
+  if (safe_reason_ != SafeReason::None) {
+    return;  // latched: the first reason stays
+  }
+  safe_reason_ = reason;
+  ++counters_.safe_state_entries;
+  write_zero_force();  // at once, whatever else this cycle still does
+}
+
+ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
+  if (safe_reason_ == SafeReason::None) {
+    return ResetOutcome::NotInSafeState;
+  }
+  // A link that latched a fault is cleared only once it is connected again.
+  if (device_.latched_fault() != hal::HapticFault::None && device_.link_state() == hal::HapticLinkState::Connected) {
+    device_.clear_fault();
+  }
+  if (!have_sample_ || cycles_since_fresh_ > config_.stale_periods ||
+      device_.latched_fault() != hal::HapticFault::None) {
+    return ResetOutcome::DeviceNotReady;
+  }
+  if (static_cast<double>(now_ns - still_since_ns_) < config_.still_time_s * kNsPerS) {
+    return ResetOutcome::DeviceNotStill;
+  }
+  const Eigen::Vector3d tool_on_device = motion::world_to_device(config_.frames, tool_.tip_mm());
+  if ((position_of(sample_) - tool_on_device).norm() > config_.reset_distance_mm) {
+    return ResetOutcome::DeviceFarFromTool;
+  }
+  safe_reason_ = SafeReason::None;
+  ramp_start_ns_ = now_ns;
+  ramping_ = true;
+  consecutive_overruns_ = 0;
+  return ResetOutcome::Accepted;
+}
+
+void Controller::handle_commands(hal::MonotonicNs now_ns) {
+  // Bounded by the ring's capacity: a command pushed while draining waits for the next cycle.
+  for (std::size_t i = 0; i < CommandRing::capacity(); ++i) {
+    Command command{};
+    if (!rings_.commands.pop(command)) {
+      break;
+    }
+    switch (command.kind) {
+      case CommandKind::Stop:
+        enter_safe_state(SafeReason::Stopped, now_ns);
+        break;
+      case CommandKind::Reset:
+        last_reset_ = try_reset(now_ns);
+        ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
+        break;
+    }
+  }
+  for (std::size_t i = 0; i < MachineEventRing::capacity(); ++i) {
+    MachineEvent event{};
+    if (!rings_.machine_events.pop(event)) {
+      break;
+    }
+    if (event.kind == MachineEventKind::Fault) {
+      enter_safe_state(SafeReason::MachineFault, now_ns);
+    }
+  }
+}
+
+bool Controller::read_device(hal::MonotonicNs now_ns) {
+  hal::HapticSample sample{};
+  const hal::ReadResult read = device_.read_sample(now_ns, sample);
+  fresh_ = false;
+  switch (read.status) {
+    case hal::ReadStatus::Fresh:
+      break;
+    case hal::ReadStatus::Stale:
+      ++counters_.stale_reads;
+      break;
+    case hal::ReadStatus::Rejected:
+      ++counters_.rejected_samples;
+      if (read.reason == hal::HapticFault::SampleOutOfRange) {
+        enter_safe_state(SafeReason::PoseOutOfWorkspace, now_ns);
+        return false;
+      }
+      break;
+    case hal::ReadStatus::Fault:
+      enter_safe_state(SafeReason::DeviceFault, now_ns);
+      return false;
+  }
+  if (read.status != hal::ReadStatus::Fresh) {
+    ++cycles_since_fresh_;
+    if (cycles_since_fresh_ > config_.stale_periods) {
+      enter_safe_state(SafeReason::DeviceStale, now_ns);
+    }
+    return have_sample_ && cycles_since_fresh_ <= config_.stale_periods;
+  }
+  const Eigen::Vector3d position = position_of(sample);
+  if (!position.allFinite() || !std::isfinite(sample.angles_rad[0]) || !std::isfinite(sample.angles_rad[1])) {
+    enter_safe_state(SafeReason::PoseNotFinite, now_ns);
+    return false;
+  }
+  if ((position.array() < config_.device_low_mm.array()).any() ||
+      (position.array() > config_.device_high_mm.array()).any()) {
+    enter_safe_state(SafeReason::PoseOutOfWorkspace, now_ns);
+    return false;
+  }
+  if (have_sample_) {
+    // The farthest a hand can move the handle since the last accepted sample (at least a period's
+    // worth, so a sample that was late by a cycle is not a jump).
+    const double seconds = static_cast<double>(now_ns - sample_time_ns_) / kNsPerS;
+    const double moved = (position - position_of(sample_)).norm();
+    if (moved > config_.max_device_speed_mm_per_s * std::max(seconds, 1e-3)) {
+      enter_safe_state(SafeReason::PoseJump, now_ns);
+      return false;
+    }
+    if (seconds > 0.0 && moved > config_.still_speed_mm_per_s * seconds) {
+      still_since_ns_ = now_ns;
+    }
+  } else {
+    still_since_ns_ = now_ns;
+  }
+  sample_ = sample;
+  sample_time_ns_ = now_ns;
+  have_sample_ = true;
+  fresh_ = true;
+  cycles_since_fresh_ = 0;
+  ++counters_.fresh_samples;
+  return true;
+}
+
+CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+  ++cycle_;
+  step_start_ns_ = now_ns;
+  statistics_.wakeup_latency.add(now_ns - deadline_ns);
+  if (cycle_ == 1) {
+    ramp_start_ns_ = now_ns;
+    still_since_ns_ = now_ns;
+  }
+  if (!ready_) {
+    enter_safe_state(SafeReason::EngineFault, now_ns);
+  }
+  handle_commands(now_ns);
+  const bool usable = read_device(now_ns);
+
+  // The engine: the device's tip in the world, the contact there, the virtual tool towards it.
+  Telemetry telemetry{};
+  telemetry.remediation = engine::RemediationStatus::Stuck;
+  const Eigen::Vector3d device = position_of(sample_);
+  const Eigen::Vector3d desired = motion::device_to_world(config_.frames, device);
+  engine::ContactResult contact{engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  engine::HapticOutput output{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false};
+  if (safe_reason_ == SafeReason::None && usable) {
+    contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
+    const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
+    telemetry.remediation = moved.status;
+    output = engine::haptic_output(desired, tool_.tip_mm(), contact, config_.haptic);
+    if (contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
+        output.fault) {
+      enter_safe_state(SafeReason::EngineFault, now_ns);
+    } else {
+      static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
+                                             touched_));
+      max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
+    }
+  }
+
+  // The force: zero in the safe state (already written when it was entered), ramped in after a reset.
+  if (safe_reason_ == SafeReason::None) {
+    double scale = 1.0;
+    if (ramping_) {
+      const double elapsed = static_cast<double>(now_ns - ramp_start_ns_) / kNsPerS;
+      scale = config_.ramp_time_s > 0.0 ? std::clamp(elapsed / config_.ramp_time_s, 0.0, 1.0) : 1.0;
+      ramping_ = scale < 1.0;
+    }
+    const Eigen::Vector3d force = usable ? Eigen::Vector3d(scale * output.force_n) : Eigen::Vector3d::Zero();
+    const Eigen::Vector3d torque = usable ? Eigen::Vector3d(scale * output.torque_nmm) : Eigen::Vector3d::Zero();
+    last_command_ = {{force.x(), force.y(), force.z()},
+                     {torque.x(), torque.y()},
+                     static_cast<std::uint32_t>(cycle_),
+                     usable};
+    max_force_n_ = std::max(max_force_n_, force.norm());
+    if (device_.write_command(last_command_).status == hal::WriteStatus::Fault) {
+      enter_safe_state(SafeReason::DeviceFault, now_ns);
+    }
+  } else {
+    write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
+  }
+
+  JournalRecord record{};
+  record.cycle = cycle_;
+  record.time_ns = now_ns;
+  copy3(device, record.device_mm);
+  record.angles_rad[0] = sample_.angles_rad[0];
+  record.angles_rad[1] = sample_.angles_rad[1];
+  record.sample_counter = sample_.sample_counter;
+  record.fresh = fresh_;
+  copy3(tool_.tip_mm(), record.virtual_tip_mm);
+  record.safe_reason = safe_reason_;  // as it stands before the machine handoff below
+  if (!rings_.journal.push(record)) {
+    enter_safe_state(SafeReason::JournalFull, now_ns);  // the record is lost: say so, stop cutting
+  }
+
+  // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
+  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
+  copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
+  if (!rings_.machine.push(handoff)) {
+    enter_safe_state(SafeReason::MachineFault, now_ns);
+  }
+
+  telemetry.cycle = cycle_;
+  telemetry.time_ns = now_ns;
+  copy3(device, telemetry.device_mm);
+  copy3(desired, telemetry.desired_tip_mm);
+  copy3(tool_.tip_mm(), telemetry.virtual_tip_mm);
+  for (int i = 0; i < 3; ++i) {
+    telemetry.force_n[i] = last_command_.force_n[i];
+  }
+  telemetry.max_depth_mm = contact.max_depth_mm;
+  telemetry.touched_triangles = static_cast<std::uint32_t>(touched_.count());
+  telemetry.safe_reason = safe_reason_;
+  if (!rings_.telemetry.push(telemetry)) {
+    ++counters_.telemetry_dropped;
+  }
+  return safe_reason_ == SafeReason::None ? CycleStatus::Running : CycleStatus::SafeState;
+}
+
+void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns) {
+  statistics_.compute.add(end_ns - step_start_ns_);
+  ++statistics_.cycles;
+  if (!config_.count_overruns) {
+    return;
+  }
+  if (end_ns > next_deadline_ns) {
+    ++statistics_.overruns;
+    if (++consecutive_overruns_ > config_.overrun_limit) {
+      enter_safe_state(SafeReason::OverrunStorm, end_ns);
+    }
+  } else {
+    consecutive_overruns_ = 0;
+  }
+}
+
+}  // namespace stencil::control

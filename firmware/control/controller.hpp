@@ -1,0 +1,143 @@
+// Controller: the 1 kHz cycle. One step() per period: commands in, read the device sample, check it,
+// map it to the world, query and remediate, write the force, hand the virtual tool to the machine
+// side, publish telemetry and the journal; and the safe state, latched, with its reset rule.
+#pragma once
+
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/loop_statistics.hpp"
+#include "firmware/control/safe_state.hpp"
+#include "firmware/control/spsc_ring.hpp"
+#include "firmware/motion/machine_frames.hpp"
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/stencil/haptic_force.hpp"
+#include "firmware/stencil/triangle_set.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/part_tables.hpp"
+#include "hal/haptic_device.hpp"
+
+namespace stencil::control {
+
+// The rings around the cycle: capacities in the types. The machine side drains its ring at each
+// machine update (about 30 Hz), so it holds well over a machine update's worth of cycles.
+using CommandRing = SpscRing<Command, 16>;
+using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
+using MachineEventRing = SpscRing<MachineEvent, 16>;
+using TelemetryRing = SpscRing<Telemetry, 64>;
+using JournalRing = SpscRing<JournalRecord, 4096>;
+
+struct CycleRings {
+  CommandRing& commands;          // in: reset, stop
+  MachineEventRing& machine_events;  // in: the machine side's faults
+  MachineHandoffRing& machine;    // out: every cycle's virtual tool
+  TelemetryRing& telemetry;       // out: dropped and counted when full
+  JournalRing& journal;           // out: full is a fault
+};
+
+// What a board decides about the cycle (the rig's numbers by default).
+struct ControllerConfig {
+  motion::MachineFrames frames;           // device -> world
+  engine::ContactParameters contact;
+  engine::HapticLimits haptic;
+  Eigen::Vector3d device_low_mm;          // a sample outside [low, high] (device mm) is out of the reach
+  Eigen::Vector3d device_high_mm;
+  Eigen::Vector3d home_tip_mm;            // world: where the virtual tool starts (the machine's home)
+  double contact_tolerance_mm = 0.005;    // a point this near the virtual tool is touched
+  int stale_periods = 5;                  // more periods than this without a fresh sample: safe state
+  double max_device_speed_mm_per_s = 3000.0;  // faster than a hand can move the handle: a jump
+  int overrun_limit = 3;                  // more consecutive overruns than this: safe state
+  bool count_overruns = true;             // false on a virtual clock, where lateness means nothing
+  double still_speed_mm_per_s = 2.0;      // a reset needs the device slower than this ...
+  double still_time_s = 0.5;              // ... for this long ...
+  double reset_distance_mm = 5.0;         // ... and this near the virtual tool (device mm)
+  double ramp_time_s = 0.5;               // force comes back over this long after a reset
+};
+
+enum class CycleStatus : std::uint8_t {
+  Running,    // force is being rendered
+  SafeState,  // force zero, machine told to stop; see safe_reason()
+};
+
+// Counters of what the cycle refused or dropped, never reset.
+struct CycleCounters {
+  std::uint64_t fresh_samples = 0;
+  std::uint64_t stale_reads = 0;
+  std::uint64_t rejected_samples = 0;  // refused by the backend (range, torn, bad frames)
+  std::uint64_t telemetry_dropped = 0;
+  std::uint64_t safe_state_entries = 0;
+  std::uint64_t resets_accepted = 0;
+  std::uint64_t resets_refused = 0;
+};
+
+class Controller {
+ public:
+  // Init time: builds the grown tool for the touched set. `part`, `device` and the rings must outlive
+  // the controller. The controller is large (the touched set): give it static storage.
+  Controller(const tables::PartTables& part, hal::HapticDevice& device, const CycleRings& rings,
+             const ControllerConfig& config);
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  // False when the grown contact tool could not be built (bad tool in the tables): do not run.
+  [[nodiscard]] bool ready() const { return ready_; }
+
+  // One cycle, started at now_ns for the period that was due at deadline_ns. Real-time safe: no
+  // allocation, lock, throw or blocking call; bounded work (the engine's bounds, the command ring's
+  // capacity).
+  [[nodiscard]] CycleStatus step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns);
+
+  // After step(): when it ended and when the next period is due, for the statistics and the
+  // overrun watchdog (which may enter the safe state, writing zero force at once). Real-time safe.
+  void finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns);
+
+  [[nodiscard]] SafeReason safe_reason() const { return safe_reason_; }
+  [[nodiscard]] ResetOutcome last_reset() const { return last_reset_; }
+  [[nodiscard]] const LoopStatistics& statistics() const { return statistics_; }
+  [[nodiscard]] const CycleCounters& counters() const { return counters_; }
+  [[nodiscard]] const engine::TriangleSet& touched() const { return touched_; }
+  [[nodiscard]] Eigen::Vector3d virtual_tip_mm() const { return tool_.tip_mm(); }
+  [[nodiscard]] const hal::HapticCommand& last_command() const { return last_command_; }
+  [[nodiscard]] double max_force_n() const { return max_force_n_; }
+  [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
+
+ private:
+  void enter_safe_state(SafeReason reason, hal::MonotonicNs now_ns);
+  void write_zero_force();
+  void handle_commands(hal::MonotonicNs now_ns);
+  [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);
+  // Reads the device and checks the sample; false when the cycle must not render force.
+  [[nodiscard]] bool read_device(hal::MonotonicNs now_ns);
+
+  const tables::PartTables& part_;
+  hal::HapticDevice& device_;
+  CycleRings rings_;
+  ControllerConfig config_;
+  engine::VirtualTool tool_;
+  geometry::ToolBsp contact_tool_{};
+  engine::TriangleSet touched_;
+  bool ready_ = false;
+
+  std::uint64_t cycle_ = 0;
+  SafeReason safe_reason_ = SafeReason::None;
+  ResetOutcome last_reset_ = ResetOutcome::NotInSafeState;
+  hal::HapticSample sample_{};             // the last accepted sample
+  bool have_sample_ = false;
+  bool fresh_ = false;                     // this cycle's read gave a new sample
+  hal::MonotonicNs sample_time_ns_ = 0;    // when it was read
+  int cycles_since_fresh_ = 0;
+  hal::MonotonicNs still_since_ns_ = 0;    // the device has been slower than the still speed since
+  hal::MonotonicNs ramp_start_ns_ = 0;     // force ramps in from here after a reset (or the start)
+  bool ramping_ = true;
+  int consecutive_overruns_ = 0;
+  hal::MonotonicNs step_start_ns_ = 0;
+  hal::HapticCommand last_command_{};
+  double max_force_n_ = 0.0;
+  double max_offset_mm_ = 0.0;
+  LoopStatistics statistics_;
+  CycleCounters counters_;
+};
+
+}  // namespace stencil::control

@@ -1,0 +1,75 @@
+// The plain-data records the cycle exchanges with the threads around it, each through its own
+// SpscRing: commands in, and out the machine handoff, telemetry and the journal.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/control/safe_state.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+
+namespace stencil::control {
+
+enum class CommandKind : std::uint8_t {
+  Reset,  // leave the safe state (accepted only while the device is held still near the virtual tool)
+  Stop,   // enter it (SIGINT/SIGTERM, the terminal, the display)
+};
+
+struct Command {
+  CommandKind kind;
+};
+
+// Why a reset was refused, or that it was taken.
+enum class ResetOutcome : std::uint8_t {
+  Accepted,
+  NotInSafeState,
+  DeviceNotStill,     // the device moved faster than the still speed in the still time
+  DeviceFarFromTool,  // the device is not near the virtual tool: force would jump
+  DeviceNotReady,     // no fresh sample, or the haptic link still latches a fault
+};
+
+// Every cycle, to the machine side: where the virtual tool is (world mm, always legal) and whether
+// the machine must stop.
+struct MachineHandoff {
+  std::uint64_t cycle;
+  double virtual_tip_mm[3];
+  bool safe_state;  // hold the feed, then switch the drivers off; move nothing until reset
+};
+
+// From the machine side, when something happens there.
+enum class MachineEventKind : std::uint8_t {
+  Fault,    // the link latched a fault: the cycle enters the safe state
+  Stopped,  // the machine is stopped (after a safe state): for the record
+};
+
+struct MachineEvent {
+  MachineEventKind kind;
+  std::uint8_t fault;  // hal::MachineFault, for Fault
+};
+
+// About 20 Hz is enough for people; the cycle pushes every cycle and a full ring drops (counted).
+struct Telemetry {
+  std::uint64_t cycle;
+  std::int64_t time_ns;
+  double device_mm[3];       // device space
+  double desired_tip_mm[3];  // world
+  double virtual_tip_mm[3];  // world
+  double force_n[3];         // as written to the device
+  double max_depth_mm;       // deepest penetration at the desired pose
+  std::uint32_t touched_triangles;
+  engine::RemediationStatus remediation;
+  SafeReason safe_reason;
+};
+
+// Everything a replay needs and nothing is allowed to lose: the journal ring being full is a fault.
+struct JournalRecord {
+  std::uint64_t cycle;
+  std::int64_t time_ns;
+  double device_mm[3];
+  double angles_rad[2];
+  std::uint32_t sample_counter;
+  bool fresh;                // a new sample this cycle
+  double virtual_tip_mm[3];
+  SafeReason safe_reason;    // as latched at the end of the cycle
+};
+
+}  // namespace stencil::control

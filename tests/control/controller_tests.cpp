@@ -1,0 +1,384 @@
+// The cycle against a scripted device and the real engine on the hex prism: following, force, and
+// every trigger of the safe state (zero force in the same period, the machine told to stop, the
+// reason latched), the reset rule and the ramp.
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "firmware/control/controller.hpp"
+#include "firmware/tables/table_loader.hpp"
+#include "tests/fakes/fake_haptic_device.hpp"
+#include "tests/support/sample_tables.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::control;
+
+namespace {
+
+constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
+const Eigen::Vector3d kHomeWorld(25.0, 12.5, 20.0);  // above the prism (top at z = 6)
+const Eigen::Vector3d kHomeDevice = 10.0 * kHomeWorld;
+
+// The hex prism's tables, made per test (so that CppUTest's leak check sees them freed).
+struct Prism {
+  tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
+  tables::PartTables part{};
+  Prism() { CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok); }
+};
+
+ControllerConfig config() {
+  ControllerConfig c;
+  c.frames = {10.0, Eigen::Vector3d::Zero(), kHomeWorld, {-1, -1, 1}, 640.0};
+  c.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
+  c.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
+  c.home_tip_mm = kHomeWorld;
+  return c;
+}
+
+// The controller with its rings and a scripted device; one cycle per call, 1 ms apart.
+struct Bench {
+  Prism prism;
+  test::FakeHapticDevice device;
+  CommandRing commands;
+  MachineEventRing machine_events;
+  MachineHandoffRing machine;
+  TelemetryRing telemetry;
+  JournalRing journal;
+  std::unique_ptr<Controller> controller;
+  hal::MonotonicNs now = 1'000'000'000;
+  MachineHandoff last_handoff{};
+  Telemetry last_telemetry{};
+  bool drain_machine = true;
+  bool drain_journal = true;
+  hal::MonotonicNs compute_ns = 100'000;  // how long each step "takes"
+
+  explicit Bench(const ControllerConfig& c = config()) {
+    device.hold_at(kHomeDevice.x(), kHomeDevice.y(), kHomeDevice.z());
+    controller = std::make_unique<Controller>(prism.part, device, CycleRings{commands, machine_events, machine, telemetry, journal}, c);
+    CHECK(controller->ready());
+  }
+
+  CycleStatus cycle() {
+    const CycleStatus status = controller->step(now, now);
+    controller->finish(now + compute_ns, now + kPeriodNs);
+    now += kPeriodNs;
+    MachineHandoff handoff{};
+    while (drain_machine && machine.pop(handoff)) {
+      last_handoff = handoff;
+    }
+    JournalRecord record{};
+    while (drain_journal && journal.pop(record)) {
+    }
+    Telemetry t{};
+    while (telemetry.pop(t)) {
+      last_telemetry = t;
+    }
+    return status;
+  }
+
+  void cycles(int n) {
+    for (int i = 0; i < n; ++i) {
+      static_cast<void>(cycle());
+    }
+  }
+
+  // Moves the device in a straight line to `to` at `speed` (device mm per second), one sample a cycle.
+  void move_device_to(const Eigen::Vector3d& to, double speed_mm_per_s) {
+    Eigen::Vector3d at(device_position());
+    const double step = speed_mm_per_s * 1e-3;
+    while ((to - at).norm() > step) {
+      at += step * (to - at).normalized();
+      device.hold_at(at.x(), at.y(), at.z());
+      static_cast<void>(cycle());
+    }
+    device.hold_at(to.x(), to.y(), to.z());
+    static_cast<void>(cycle());
+  }
+
+  [[nodiscard]] Eigen::Vector3d device_position() const {
+    return {last_telemetry.device_mm[0], last_telemetry.device_mm[1], last_telemetry.device_mm[2]};
+  }
+
+  [[nodiscard]] double force_written() const {
+    const hal::HapticCommand& c = device.last_command();
+    return std::sqrt(c.force_n[0] * c.force_n[0] + c.force_n[1] * c.force_n[1] + c.force_n[2] * c.force_n[2]);
+  }
+};
+
+// The outcome every trigger must have, in the very cycle that saw it.
+void check_safe(const Bench& bench, SafeReason reason) {
+  CHECK_TEXT(bench.controller->safe_reason() == reason, safe_reason_name(bench.controller->safe_reason()));
+  const hal::HapticCommand& command = bench.device.last_command();
+  CHECK_FALSE(command.enable);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);
+  DOUBLES_EQUAL(0.0, command.torque_nmm[0], 0.0);
+  DOUBLES_EQUAL(0.0, command.torque_nmm[1], 0.0);
+  CHECK(bench.last_handoff.safe_state);  // the machine side is told to hold and stop
+  CHECK(bench.last_telemetry.safe_reason == reason);
+}
+
+}  // namespace
+
+TEST_GROUP(Controller){};
+
+TEST(Controller, FollowsTheDeviceInFreeSpaceWithNoForce) {
+  Bench bench;
+  bench.cycles(5);
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(30.0, -20.0, 10.0), 500.0);
+  CHECK(bench.cycle() == CycleStatus::Running);
+  const Eigen::Vector3d tip = bench.controller->virtual_tip_mm();
+  CHECK((tip - (kHomeWorld + Eigen::Vector3d(3.0, -2.0, 1.0))).norm() < 1e-9);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 1e-9);
+  CHECK(bench.device.last_command().enable);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  CHECK(bench.last_handoff.virtual_tip_mm[0] == tip.x());
+  CHECK_FALSE(bench.last_handoff.safe_state);
+}
+
+TEST(Controller, PushedIntoThePartTheToolStaysOnTheSurfaceAndTheOperatorFeelsIt) {
+  Bench bench;
+  bench.cycles(600);  // past the start-up ramp
+  // Down onto the top face (z = 6 world) and 0.2 mm (2 device mm) into it.
+  bench.move_device_to({250.0, 125.0, 58.0}, 1000.0);
+  bench.cycles(10);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  const Eigen::Vector3d tip = bench.controller->virtual_tip_mm();
+  CHECK(tip.z() >= 6.0 - bench.prism.part.header.gouge_bound_mm - 1e-6);
+  CHECK(tip.z() < 6.01);
+  const hal::HapticCommand& command = bench.device.last_command();
+  CHECK(command.force_n[2] > 1.0);  // pushing the hand back up
+  CHECK(bench.force_written() <= 5.0 + 1e-12);
+  CHECK(bench.controller->touched().count() > 0);  // the top's triangles, touched by the virtual tool
+}
+
+TEST(Controller, AStaleDeviceForMoreThanFivePeriodsEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.give(hal::ReadStatus::Stale);
+  for (int i = 0; i < 5; ++i) {
+    CHECK(bench.cycle() == CycleStatus::Running);
+  }
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::DeviceStale);
+}
+
+TEST(Controller, ANonFinitePoseEntersTheSafeStateInThatPeriod) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.hold_at(std::numeric_limits<double>::quiet_NaN(), 125.0, 200.0);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::PoseNotFinite);
+}
+
+TEST(Controller, APoseOutsideTheReachEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.move_device_to({250.0, 125.0, 273.0}, 1000.0);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  bench.device.hold_at(250.0, 125.0, 276.0);  // 1 mm beyond the margin, 3 mm in a period: not a jump
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::PoseOutOfWorkspace);
+}
+
+TEST(Controller, ASampleTheBackendRefusedAsOutOfRangeEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.give(hal::ReadStatus::Rejected, hal::HapticFault::SampleOutOfRange);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::PoseOutOfWorkspace);
+}
+
+TEST(Controller, AJumpFartherThanAHandCanMoveInOnePeriodEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.hold_at(kHomeDevice.x() + 2.9, kHomeDevice.y(), kHomeDevice.z());  // 2.9 m/s: a hand
+  CHECK(bench.cycle() == CycleStatus::Running);
+  bench.device.hold_at(kHomeDevice.x() + 2.9 + 3.2, kHomeDevice.y(), kHomeDevice.z());  // 3.2 m/s: not
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::PoseJump);
+}
+
+TEST(Controller, ADeviceLinkFaultEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.give(hal::ReadStatus::Fault, hal::HapticFault::DeviceHeartbeatLost);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::DeviceFault);
+}
+
+TEST(Controller, AForceWriteThatFailsEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.fail_writes(true);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  CHECK(bench.controller->safe_reason() == SafeReason::DeviceFault);
+  CHECK(bench.last_handoff.safe_state);
+}
+
+TEST(Controller, AMachineFaultEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.machine_events.push({MachineEventKind::Fault, 4}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::MachineFault);
+}
+
+TEST(Controller, AMachineSideThatFallsAWholeRingBehindEntersTheSafeState) {
+  Bench bench;
+  bench.drain_machine = false;
+  for (std::size_t i = 0; i < MachineHandoffRing::capacity(); ++i) {
+    CHECK(bench.cycle() == CycleStatus::Running);
+  }
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  CHECK(bench.controller->safe_reason() == SafeReason::MachineFault);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);
+  CHECK_FALSE(bench.device.last_command().enable);
+}
+
+TEST(Controller, MoreThanThreeOverrunsInARowEnterTheSafeStateButThreeDoNot) {
+  Bench bench;
+  bench.cycles(20);
+  bench.compute_ns = kPeriodNs + 1;  // each step ends after the next deadline
+  bench.cycles(3);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  bench.compute_ns = 100'000;
+  bench.cycles(1);  // on time: the run of overruns ends
+  bench.compute_ns = kPeriodNs + 1;
+  bench.cycles(3);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  LONGS_EQUAL(6, bench.controller->statistics().overruns);
+  static_cast<void>(bench.controller->step(bench.now, bench.now));
+  bench.controller->finish(bench.now + bench.compute_ns, bench.now + kPeriodNs);  // the fourth in a row
+  CHECK(bench.controller->safe_reason() == SafeReason::OverrunStorm);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);  // written at once, not a period later
+  CHECK_FALSE(bench.device.last_command().enable);
+}
+
+TEST(Controller, OnAVirtualClockOverrunsAreNotCounted) {
+  ControllerConfig c = config();
+  c.count_overruns = false;
+  Bench bench(c);
+  bench.compute_ns = 10 * kPeriodNs;
+  bench.cycles(20);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  LONGS_EQUAL(0, bench.controller->statistics().overruns);
+}
+
+TEST(Controller, AFullJournalRingEntersTheSafeStateForTheJournalMustLoseNothing) {
+  Bench bench;
+  bench.drain_journal = false;
+  for (std::size_t i = 0; i < JournalRing::capacity(); ++i) {
+    CHECK(bench.cycle() == CycleStatus::Running);
+  }
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::JournalFull);
+}
+
+TEST(Controller, AFullTelemetryRingOnlyDropsAndCounts) {
+  Bench bench;
+  TelemetryRing& ring = bench.telemetry;
+  for (std::size_t i = 0; i < TelemetryRing::capacity(); ++i) {
+    CHECK(ring.push({}));
+  }
+  static_cast<void>(bench.controller->step(bench.now, bench.now));
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  LONGS_EQUAL(1, bench.controller->counters().telemetry_dropped);
+}
+
+TEST(Controller, AStopCommandEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.commands.push({CommandKind::Stop}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::Stopped);
+}
+
+TEST(Controller, TheSafeStateLatchesWhenItsCauseIsGone) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.hold_at(std::numeric_limits<double>::quiet_NaN(), 125.0, 200.0);
+  bench.cycles(1);
+  bench.device.hold_at(kHomeDevice.x(), kHomeDevice.y(), kHomeDevice.z());
+  for (int i = 0; i < 2000; ++i) {
+    CHECK(bench.cycle() == CycleStatus::SafeState);
+  }
+  check_safe(bench, SafeReason::PoseNotFinite);
+}
+
+TEST(Controller, AResetIsRefusedWhileTheDeviceMovesOrIsFarFromTheToolAndTakenWhenItIsHeldStillNearIt) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.commands.push({CommandKind::Stop}));
+  bench.cycles(1);
+  // Moving at 10 mm/s: not still.
+  for (int i = 0; i < 600; ++i) {
+    bench.device.hold_at(kHomeDevice.x() + 0.01 * i, kHomeDevice.y(), kHomeDevice.z());
+    bench.cycles(1);
+  }
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  bench.cycles(1);
+  CHECK(bench.controller->last_reset() == ResetOutcome::DeviceNotStill);
+  CHECK(bench.controller->safe_reason() == SafeReason::Stopped);
+  // Still, but 6 mm from the virtual tool (which stayed where the stop found it).
+  bench.cycles(600);
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  bench.cycles(1);
+  CHECK(bench.controller->last_reset() == ResetOutcome::DeviceFarFromTool);
+  CHECK(bench.controller->safe_reason() == SafeReason::Stopped);
+  // Back near it, then held still for 0.5 s.
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(1.0, 0.0, 0.0), 100.0);
+  bench.cycles(400);
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  bench.cycles(1);
+  CHECK(bench.controller->last_reset() == ResetOutcome::DeviceNotStill);  // 0.4 s only
+  bench.cycles(100);
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  CHECK(bench.cycle() == CycleStatus::Running);
+  CHECK(bench.controller->last_reset() == ResetOutcome::Accepted);
+  LONGS_EQUAL(1, bench.controller->counters().resets_accepted);
+  LONGS_EQUAL(3, bench.controller->counters().resets_refused);
+}
+
+TEST(Controller, AfterAResetTheForceRampsBackInOverHalfASecond) {
+  Bench bench;
+  bench.cycles(600);
+  bench.move_device_to({250.0, 125.0, 58.0}, 1000.0);  // 0.2 mm into the top face
+  bench.cycles(10);
+  const double full = bench.force_written();
+  CHECK(full > 1.0);
+  CHECK(bench.commands.push({CommandKind::Stop}));
+  bench.cycles(1);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);
+  bench.cycles(600);  // held still, 2 mm from the virtual tool on the surface
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  bench.cycles(1);
+  CHECK(bench.controller->last_reset() == ResetOutcome::Accepted);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 1e-12);  // the ramp starts at zero
+  bench.cycles(249);
+  DOUBLES_EQUAL(0.5 * full, bench.force_written(), 0.01 * full);
+  bench.cycles(260);
+  DOUBLES_EQUAL(full, bench.force_written(), 1e-9 * full);
+}
+
+TEST(Controller, AResetOutsideTheSafeStateIsRefusedAndChangesNothing) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  CHECK(bench.cycle() == CycleStatus::Running);
+  CHECK(bench.controller->last_reset() == ResetOutcome::NotInSafeState);
+}
+
+TEST(Controller, AResetWhileTheDeviceLinkIsStillDownIsRefused) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.give(hal::ReadStatus::Fault, hal::HapticFault::DeviceHeartbeatLost);
+  bench.device.connect(false);
+  bench.cycles(600);
+  CHECK(bench.commands.push({CommandKind::Reset}));
+  bench.cycles(1);
+  CHECK(bench.controller->last_reset() == ResetOutcome::DeviceNotReady);
+  CHECK(bench.controller->safe_reason() == SafeReason::DeviceFault);
+}
