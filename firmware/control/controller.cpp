@@ -25,6 +25,7 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
                        const ControllerConfig& config)
     : part_(part), device_(device), rings_(rings), config_(config), tool_(part, config.home_tip_mm) {
   ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
+  tool_.limit_speed(config.max_axis_move_mm, config.max_total_move_mm);
   last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
 }
 

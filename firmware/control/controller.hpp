@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 
 #include <Eigen/Core>
 
@@ -46,6 +47,10 @@ struct ControllerConfig {
   Eigen::Vector3d device_high_mm;
   Eigen::Vector3d home_tip_mm;            // world: where the virtual tool starts (the machine's home)
   double contact_tolerance_mm = 0.005;    // a point this near the virtual tool is touched
+  // The most the virtual tool may move in one period, per axis and all axes together (|dx|+|dy|+|dz|),
+  // so the mill can follow (motion::MachineSpeed times the period); unlimited by default.
+  double max_axis_move_mm = std::numeric_limits<double>::infinity();
+  double max_total_move_mm = std::numeric_limits<double>::infinity();
   int stale_periods = 5;                  // more periods than this without a fresh sample: safe state
   double max_device_speed_mm_per_s = 3000.0;  // faster than a hand can move the handle: a jump
   int overrun_limit = 3;                  // more consecutive overruns than this: safe state

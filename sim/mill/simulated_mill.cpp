@@ -63,6 +63,9 @@ StepOutcome SimulatedMill::step_motor(Axis axis, StepDirection direction) {
     return StepOutcome::took_up_backlash;
   }
   state.axis_steps = nut;
+  if (observer_ != nullptr) {
+    observer_->axis_moved(axis, {axes_[0].axis_steps, axes_[1].axis_steps, axes_[2].axis_steps});
+  }
   return StepOutcome::moved;
 }
 

@@ -52,6 +52,16 @@ enum class StepOutcome : std::uint8_t {
 // motion: a = m). After a reversal the motor therefore turns exactly `backlash` steps before the axis
 // moves. The motor position is the screw's angle expressed in axis steps, not a count from power-up.
 //
+// Told of every step that moved an axis (not take-ups, stalls or steps with the drivers off), with
+// every axis's position after it: the ground truth of the path the tool followed.
+class MillMotionObserver {
+ public:
+  virtual void axis_moved(Axis axis, const std::array<std::int64_t, kMillAxisCount>& axis_steps) = 0;
+
+ protected:
+  ~MillMotionObserver() = default;
+};
+
 // Not thread-safe; plain value state, no allocation.
 class SimulatedMill {
  public:
@@ -66,6 +76,8 @@ class SimulatedMill {
   void set_drivers_enabled(bool enabled) { drivers_enabled_ = enabled; }
   [[nodiscard]] bool drivers_enabled() const { return drivers_enabled_; }
   void set_spindle_on(bool on) { spindle_on_ = on; }
+  // Null for none. The observer must outlive its registration.
+  void set_motion_observer(MillMotionObserver* observer) { observer_ = observer; }
   [[nodiscard]] bool spindle_on() const { return spindle_on_; }
 
   // True while the axis is below its home switch's edge.
@@ -99,6 +111,7 @@ class SimulatedMill {
   bool drivers_enabled_ = false;
   bool spindle_on_ = false;
   std::int64_t steps_ignored_while_disabled_ = 0;
+  MillMotionObserver* observer_ = nullptr;
 };
 
 }  // namespace stencil::sim

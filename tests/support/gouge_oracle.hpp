@@ -6,7 +6,7 @@
 #include <Eigen/Core>
 
 #include "firmware/tables/part_tables.hpp"
-#include "tests/support/triangle_distance.hpp"
+#include "sim/mill/triangle_distance.hpp"
 
 namespace stencil::test {
 
@@ -21,7 +21,7 @@ inline double ball_end_gouge_mm(const tables::PartTables& part, const Eigen::Vec
   for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
     const auto& v = part.triangles[t].vertices;
     const auto vertex = [&](int i) { return Eigen::Vector3d(v[i].x_mm, v[i].y_mm, v[i].z_mm); };
-    deepest = std::max(deepest, radius - segment_triangle_distance(low, high, vertex(0), vertex(1), vertex(2)));
+    deepest = std::max(deepest, radius - sim::segment_triangle_distance(low, high, vertex(0), vertex(1), vertex(2)));
   }
   return deepest;
 }

@@ -1,5 +1,6 @@
 // Exact distances between a segment and a triangle, written plainly (Ericson, Real-Time Collision
-// Detection, 5.1.5 and 5.1.9): the oracle that says whether a ball end mill gouges the true surface.
+// Detection, 5.1.5 and 5.1.9): what says whether a ball end mill gouges the true surface, for the
+// simulated mill's gouge figure and the engine tests' oracle alike (neither is the engine).
 #pragma once
 
 #include <algorithm>
@@ -8,7 +9,7 @@
 
 #include <Eigen/Geometry>
 
-namespace stencil::test {
+namespace stencil::sim {
 
 inline Eigen::Vector3d closest_on_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
                                            const Eigen::Vector3d& c) {
@@ -78,4 +79,4 @@ inline double segment_triangle_distance(const Eigen::Vector3d& p, const Eigen::V
   return best;
 }
 
-}  // namespace stencil::test
+}  // namespace stencil::sim

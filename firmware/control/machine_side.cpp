@@ -1,0 +1,92 @@
+// The machine update: path in, one target out, stop on the safe state.
+#include "firmware/control/machine_side.hpp"
+
+#include <algorithm>
+
+namespace stencil::control {
+
+MachineSide::MachineSide(const tables::PartTables& part, hal::MachineLink& link, const motion::MachineFrames& frames, const motion::PlannerLimits& limits,
+                         MachineHandoffRing& from_cycle, MachineEventRing& to_cycle)
+    : link_(link), from_cycle_(from_cycle), to_cycle_(to_cycle), planner_(part, frames, limits) {}
+
+bool MachineSide::start(hal::MonotonicNs deadline_ns) {
+  if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
+    return false;
+  }
+  planner_.homed({{0, 0, 0}}, link_.home_approach());
+  moves_seen_ = link_.status().moves_done;
+  state_ = MachineSideState::Cutting;
+  return true;
+}
+
+void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault) {
+  if (report_fault) {
+    // A full event ring means the cycle already has a fault to read: it is in its safe state.
+    static_cast<void>(
+        to_cycle_.push({MachineEventKind::Fault, static_cast<std::uint8_t>(link_.status().fault)}));
+  }
+  if (state_ == MachineSideState::Stopped) {
+    return;
+  }
+  state_ = MachineSideState::Stopped;
+  link_.hold();
+  static_cast<void>(link_.stop(deadline_ns));  // a link already in fault is stopped as far as it can be
+  static_cast<void>(to_cycle_.push({MachineEventKind::Stopped, 0}));
+}
+
+void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
+  // Every handoff since the last update, in order: the planner follows the virtual tool's path.
+  bool safe_state = false;
+  for (std::size_t i = 0; i < MachineHandoffRing::capacity(); ++i) {
+    MachineHandoff handoff{};
+    if (!from_cycle_.pop(handoff)) {
+      break;
+    }
+    safe_state = safe_state || handoff.safe_state;
+    if (state_ == MachineSideState::Cutting && !handoff.safe_state) {
+      const Eigen::Vector3d tip(handoff.virtual_tip_mm[0], handoff.virtual_tip_mm[1], handoff.virtual_tip_mm[2]);
+      if (planner_.follow(tip) == motion::PathStatus::Full) {
+        stop(update_deadline_ns, true);  // the mill fell too far behind to follow the path
+      }
+    }
+  }
+  if (state_ != MachineSideState::Cutting) {
+    return;
+  }
+  if (safe_state) {
+    stop(update_deadline_ns, false);
+    return;
+  }
+  const std::uint64_t moves_done = link_.status().moves_done;
+  const auto completed = static_cast<int>(std::min<std::uint64_t>(moves_done - moves_seen_, 8));
+  moves_seen_ = moves_done;
+  const motion::PlanResult plan = planner_.plan(completed);
+  statistics_.max_lag_mm = std::max(statistics_.max_lag_mm, plan.lag_mm);
+  at_goal_ = plan.status == motion::PlanStatus::AtGoal;
+  switch (plan.status) {
+    case motion::PlanStatus::Moved:
+    case motion::PlanStatus::TakingUp: {
+      const hal::MachineResult moved = link_.move({plan.motor_target.axis, plan.order, true}, update_deadline_ns);
+      if (!moved.done) {
+        stop(update_deadline_ns, true);
+        return;
+      }
+      ++statistics_.updates;
+      statistics_.take_ups += plan.status == motion::PlanStatus::TakingUp ? 1 : 0;
+      statistics_.motor_steps += plan.motor_steps;
+      break;
+    }
+    case motion::PlanStatus::Blocked:
+      ++statistics_.blocked;
+      break;
+    case motion::PlanStatus::Fault:
+    case motion::PlanStatus::NotHomed:
+      stop(update_deadline_ns, true);
+      break;
+    case motion::PlanStatus::AtGoal:
+    case motion::PlanStatus::Waiting:
+      break;
+  }
+}
+
+}  // namespace stencil::control

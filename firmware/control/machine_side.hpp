@@ -1,0 +1,67 @@
+// MachineSide: what the machine thread does at each machine update (about 30 Hz): takes the
+// cycle's virtual tool positions into the planner's path, sends the next legal target to the mill,
+// and on the cycle's safe state holds the feed and stops the machine. Not the 1 kHz cycle: the link
+// may block up to its deadlines. Allocation-free all the same.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/spsc_ring.hpp"
+#include "firmware/control/controller.hpp"
+#include "firmware/motion/machine_planner.hpp"
+#include "hal/clock.hpp"  // MonotonicNs
+#include "hal/machine_link.hpp"
+
+namespace stencil::control {
+
+enum class MachineSideState : std::uint8_t {
+  NotStarted,  // start() not called or it failed
+  Cutting,     // homed, spindle on, following the virtual tool
+  Stopped,     // the cycle's safe state (or a fault here): held, spindle and drivers off
+};
+
+struct MachineSideStatistics {
+  std::uint64_t updates = 0;      // targets sent
+  std::uint64_t take_ups = 0;     // of which only took up backlash
+  std::uint64_t blocked = 0;      // updates with no legal staircase (held)
+  double max_lag_mm = 0.0;        // virtual tool to the mill's target, world
+  std::int64_t motor_steps = 0;   // all axes, take-up included
+};
+
+class MachineSide {
+ public:
+  // The rings are the cycle's; part, link and rings must outlive this object.
+  MachineSide(const tables::PartTables& part, hal::MachineLink& link, const motion::MachineFrames& frames, const motion::PlannerLimits& limits,
+              MachineHandoffRing& from_cycle, MachineEventRing& to_cycle);
+
+  // Init: wakes the controller, homes on the switches, turns the spindle on. False with the link's
+  // fault on failure (nothing moves then).
+  [[nodiscard]] bool start(hal::MonotonicNs deadline_ns);
+
+  // One machine update, by update_deadline_ns: drains the cycle's handoffs, then plans and sends
+  // at most one target. A fault here is reported to the cycle and stops the machine.
+  void update(hal::MonotonicNs update_deadline_ns);
+
+  [[nodiscard]] MachineSideState state() const { return state_; }
+  [[nodiscard]] hal::MachineFault fault() const { return link_.status().fault; }
+  [[nodiscard]] const MachineSideStatistics& statistics() const { return statistics_; }
+  // Queued points of the virtual tool's path the mill has not reached yet (0: drained).
+  [[nodiscard]] std::size_t path_left() const { return planner_.path_size(); }
+  [[nodiscard]] bool at_goal() const { return at_goal_; }
+  [[nodiscard]] const motion::MachinePlanner& planner() const { return planner_; }
+
+ private:
+  void stop(hal::MonotonicNs deadline_ns, bool report_fault);
+
+  hal::MachineLink& link_;
+  MachineHandoffRing& from_cycle_;
+  MachineEventRing& to_cycle_;
+  motion::MachinePlanner planner_;
+  MachineSideState state_ = MachineSideState::NotStarted;
+  std::uint64_t moves_seen_ = 0;
+  bool at_goal_ = false;
+  MachineSideStatistics statistics_;
+};
+
+}  // namespace stencil::control

@@ -1,0 +1,44 @@
+// FakeCy545Clock: the machine side's clock in fast simulation. Virtual time, which the fake CY545
+// follows: whenever the driver looks at the time or sleeps, the fake runs to that time and answers
+// what the driver wrote. Bytes take their wire time (ten bits each at the baud rate), so an update
+// costs the time it would on the rig's serial line, and time always moves while the driver talks.
+// One thread: the driver's and the fake's, taking turns; deterministic.
+#pragma once
+
+#include <cstdint>
+
+#include "hal/clock.hpp"
+#include "sim/cy545/fake_cy545.hpp"
+
+namespace stencil::sim::cy545 {
+
+class FakeCy545Clock final : public hal::Clock {
+ public:
+  FakeCy545Clock(FakeCy545& fake, hal::MonotonicNs start_ns, double baud)
+      : fake_(fake), now_(start_ns), byte_ns_(static_cast<hal::MonotonicNs>(10.0 * 1e9 / baud)) {}
+
+  // Time passes by the wire time of every byte that crossed the line since the last look.
+  [[nodiscard]] hal::MonotonicNs now_ns() const override {
+    fake_.step(now_);
+    const PtyCounters& counters = fake_.pty_counters();
+    const std::int64_t crossed = counters.bytes_read + counters.bytes_written;
+    now_ += (crossed - bytes_seen_) * byte_ns_;
+    bytes_seen_ = crossed;
+    return now_;
+  }
+
+  void sleep_until_ns(hal::MonotonicNs deadline_ns) override {
+    if (deadline_ns > now_) {
+      now_ = deadline_ns;
+    }
+    static_cast<void>(now_ns());
+  }
+
+ private:
+  FakeCy545& fake_;
+  mutable hal::MonotonicNs now_;
+  mutable std::int64_t bytes_seen_ = 0;
+  hal::MonotonicNs byte_ns_;
+};
+
+}  // namespace stencil::sim::cy545

@@ -1,0 +1,223 @@
+// Ground truth of the cut: legs of the mill's path into the Z-map, gouge against the triangles.
+#include "sim/mill/machined_part.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+#include "sim/mill/triangle_distance.hpp"
+
+namespace stencil::sim {
+namespace {
+
+Eigen::Vector3d vertex(const tables::PackedTriangle& triangle, int i) {
+  const tables::PackedPoint& v = triangle.vertices[static_cast<std::size_t>(i)];
+  return {v.x_mm, v.y_mm, v.z_mm};
+}
+
+// Distance between two triangles: they are apart by the nearest of one's edges to the other (and
+// touch when an edge crosses the other, which the segment distance reports as 0).
+double triangle_triangle_distance(const std::array<Eigen::Vector3d, 3>& p, const std::array<Eigen::Vector3d, 3>& q) {
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < 3; ++i) {
+    best = std::min(best, segment_triangle_distance(p[i], p[(i + 1) % 3], q[0], q[1], q[2]));
+    best = std::min(best, segment_triangle_distance(q[i], q[(i + 1) % 3], p[0], p[1], p[2]));
+  }
+  return best;
+}
+
+}  // namespace
+
+MachinedPart::MachinedPart(const tables::PartTables& part, const StockBox& stock, const motion::MachineFrames& frames,
+                           std::function<double()> now_s)
+    : part_(part),
+      frames_(frames),
+      now_s_(std::move(now_s)),
+      stock_(stock, 0.05),
+      tool_(ToolProfile::of(part.tool.spec)),
+      gouge_measured_(part.tool.spec.kind == geometry::CutterKind::Ball) {}
+
+Eigen::Vector3d MachinedPart::world_of(const std::array<std::int64_t, kMillAxisCount>& axis_steps) const {
+  motion::MachineSteps steps{};
+  for (std::size_t i = 0; i < 3; ++i) {
+    steps.axis[i] = static_cast<std::int32_t>(axis_steps[i] - home_[i]);
+  }
+  return motion::steps_to_world(frames_, steps);
+}
+
+void MachinedPart::arm(const std::array<std::int64_t, kMillAxisCount>& home_axis_steps) {
+  home_ = home_axis_steps;
+  armed_ = true;
+  leg_axis_ = -1;
+  leg_start_ = leg_end_ = world_of(home_axis_steps);
+  corner(leg_start_);
+}
+
+void MachinedPart::corner(const Eigen::Vector3d& tip) {
+  last_corner_ = {now_s_ ? now_s_() : 0.0, tip};
+  if (trace_ != nullptr) {
+    std::fprintf(trace_, "%.6f,%.6f,%.6f,%.6f\n", last_corner_.t_s, tip.x(), tip.y(), tip.z());
+  }
+}
+
+void MachinedPart::axis_moved(Axis axis, const std::array<std::int64_t, kMillAxisCount>& axis_steps) {
+  if (!armed_) {
+    return;
+  }
+  const int moving = static_cast<int>(axis);
+  if (leg_axis_ >= 0 && moving != leg_axis_) {
+    finish_leg();
+  }
+  leg_axis_ = moving;
+  leg_end_ = world_of(axis_steps);
+}
+
+void MachinedPart::flush() {
+  if (armed_ && leg_axis_ >= 0) {
+    finish_leg();
+  }
+}
+
+void MachinedPart::finish_leg() {
+  stock_.cut(leg_start_, leg_end_, tool_);
+  if (gouge_measured_) {
+    max_gouge_mm_ = std::max(max_gouge_mm_, leg_gouge(leg_start_, leg_end_));
+  }
+  ++legs_;
+  corner(leg_end_);
+  leg_start_ = leg_end_;
+  leg_axis_ = -1;
+}
+
+// The ball end mill's cutter is a capsule of radius R round the axis from tip + R up to the top of
+// the flutes. Moved along one axis, it sweeps that capsule's core (a segment) into a vertical
+// rectangle (a horizontal move) or a longer segment (a vertical one), grown by R: a triangle of the
+// part is cut into by R less its distance from that core.
+double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  const double radius = part_.tool.envelope.cutter_radius_mm;
+  const double flutes = part_.tool.envelope.flute_length_mm;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d low_from = from + radius * up, low_to = to + radius * up;
+  const Eigen::Vector3d high_from = from + flutes * up, high_to = to + flutes * up;
+  const bool vertical = from.x() == to.x() && from.y() == to.y();
+  const Eigen::Vector3d core_low = vertical ? (from.z() < to.z() ? low_from : low_to) : low_from;
+  const Eigen::Vector3d core_high = vertical ? (from.z() < to.z() ? high_to : high_from) : high_to;
+  const Eigen::Vector3d box_low = low_from.cwiseMin(low_to).array() - radius;
+  const Eigen::Vector3d box_high = high_from.cwiseMax(high_to).array() + radius;
+  double deepest = 0.0;
+  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
+    const std::array<Eigen::Vector3d, 3> triangle{vertex(part_.triangles[t], 0), vertex(part_.triangles[t], 1),
+                                                  vertex(part_.triangles[t], 2)};
+    const Eigen::Vector3d t_low = triangle[0].cwiseMin(triangle[1]).cwiseMin(triangle[2]);
+    const Eigen::Vector3d t_high = triangle[0].cwiseMax(triangle[1]).cwiseMax(triangle[2]);
+    if ((t_low.array() > box_high.array()).any() || (t_high.array() < box_low.array()).any()) {
+      continue;  // farther than the radius from the swept core
+    }
+    double distance = 0.0;
+    if (vertical || from == to) {
+      distance = segment_triangle_distance(core_low, core_high, triangle[0], triangle[1], triangle[2]);
+    } else {
+      const std::array<Eigen::Vector3d, 3> half_a{low_from, low_to, high_to};
+      const std::array<Eigen::Vector3d, 3> half_b{low_from, high_to, high_from};
+      distance = std::min(triangle_triangle_distance(half_a, triangle), triangle_triangle_distance(half_b, triangle));
+    }
+    deepest = std::max(deepest, radius - distance);
+  }
+  return deepest;
+}
+
+std::vector<double> MachinedPart::part_heights() const {
+  // The part's top over each cell centre: the highest triangle above it (the part stands on the
+  // floor; a cell with no part over it is the floor's height).
+  std::vector<double> heights(static_cast<std::size_t>(stock_.columns()) * static_cast<std::size_t>(stock_.rows()),
+                              stock_.box().low_mm.z());
+  const double cell = stock_.cell_mm();
+  const Eigen::Vector3d origin = stock_.box().low_mm;
+  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
+    const Eigen::Vector3d a = vertex(part_.triangles[t], 0), b = vertex(part_.triangles[t], 1),
+                          c = vertex(part_.triangles[t], 2);
+    const double area = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
+    if (std::abs(area) < 1e-12) {
+      continue;  // seen edge-on from above: a wall
+    }
+    const int c0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - origin.x()) / cell)));
+    const int c1 = std::min(stock_.columns() - 1, static_cast<int>(std::floor((std::max({a.x(), b.x(), c.x()}) - origin.x()) / cell)));
+    const int r0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - origin.y()) / cell)));
+    const int r1 = std::min(stock_.rows() - 1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - origin.y()) / cell)));
+    for (int row = r0; row <= r1; ++row) {
+      for (int column = c0; column <= c1; ++column) {
+        const Eigen::Vector2d p = stock_.centre(column, row);
+        const double w0 = ((b.x() - p.x()) * (c.y() - p.y()) - (c.x() - p.x()) * (b.y() - p.y())) / area;
+        const double w1 = ((c.x() - p.x()) * (a.y() - p.y()) - (a.x() - p.x()) * (c.y() - p.y())) / area;
+        const double w2 = 1.0 - w0 - w1;
+        if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) {
+          continue;
+        }
+        double& height = heights[static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) +
+                                 static_cast<std::size_t>(column)];
+        height = std::max(height, w0 * a.z() + w1 * b.z() + w2 * c.z());
+      }
+    }
+  }
+  return heights;
+}
+
+MachinedPart::Volumes MachinedPart::volumes() const {
+  const std::vector<double> part = part_heights();
+  const int columns = stock_.columns(), rows = stock_.rows();
+  const double cell = stock_.cell_mm();
+  const double floor = stock_.box().low_mm.z();
+  const double top = stock_.box().high_mm.z();
+  const auto at = [&](const std::vector<double>& grid, int column, int row) -> double {
+    return grid[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)];
+  };
+  // The lowest tip over each cell that keeps the tool out of the part (and off the floor), then the
+  // lowest the tool's surface can come over each cell from any such tip: the reachable surface.
+  const int reach = static_cast<int>(std::ceil(tool_.radius_mm / cell));
+  std::vector<double> tip(part.size(), floor);
+  for (int row = 0; row < rows; ++row) {
+    for (int column = 0; column < columns; ++column) {
+      double lowest = floor;
+      for (int dr = -reach; dr <= reach; ++dr) {
+        for (int dc = -reach; dc <= reach; ++dc) {
+          const int r = row + dr, c = column + dc;
+          if (r < 0 || r >= rows || c < 0 || c >= columns) {
+            continue;
+          }
+          const double lift = tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc)));
+          if (std::isfinite(lift)) {
+            lowest = std::max(lowest, at(part, c, r) - lift);
+          }
+        }
+      }
+      tip[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] = lowest;
+    }
+  }
+  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0};
+  for (int row = 0; row < rows; ++row) {
+    for (int column = 0; column < columns; ++column) {
+      double reachable = top;
+      for (int dr = -reach; dr <= reach; ++dr) {
+        for (int dc = -reach; dc <= reach; ++dc) {
+          const int r = row + dr, c = column + dc;
+          if (r < 0 || r >= rows || c < 0 || c >= columns) {
+            continue;
+          }
+          reachable = std::min(reachable, at(tip, c, r) + tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc))));
+        }
+      }
+      reachable = std::max(reachable, at(part, column, row));
+      const double left = stock_.height(column, row);
+      v.reachable_mm3 += std::max(0.0, top - reachable);
+      v.unmachined_mm3 += std::max(0.0, left - std::max(reachable, floor)) * (reachable < top ? 1.0 : 0.0);
+      v.gouge_mm3 += std::max(0.0, at(part, column, row) - left);
+    }
+  }
+  v.reachable_mm3 *= cell * cell;
+  v.unmachined_mm3 *= cell * cell;
+  v.gouge_mm3 *= cell * cell;
+  return v;
+}
+
+}  // namespace stencil::sim

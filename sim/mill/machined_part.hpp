@@ -1,0 +1,89 @@
+// What the simulated mill did to the part, measured from ground truth only: the path the mill's
+// tool really followed (after backlash), cut into the stock's Z-map, and the deepest penetration of
+// the true tool into the part's own triangles anywhere along it.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "firmware/motion/machine_frames.hpp"
+#include "firmware/tables/part_tables.hpp"
+#include "sim/mill/simulated_mill.hpp"
+#include "sim/mill/stock_zmap.hpp"
+
+namespace stencil::sim {
+
+// One corner of the path the mill followed: where the moving axis changed or motion stopped.
+struct PathCorner {
+  double t_s;
+  Eigen::Vector3d tip_mm;
+};
+
+// Listens to the simulated mill: every move of an axis extends the current straight leg; a leg
+// ends when another axis moves or flush() is called (motion stopped). Each finished leg is cut into
+// the Z-map and measured against the part's triangles.
+class MachinedPart final : public MillMotionObserver {
+ public:
+  // `now_s` gives the simulated time of a step, for the trace.
+  MachinedPart(const tables::PartTables& part, const StockBox& stock, const motion::MachineFrames& frames,
+               std::function<double()> now_s);
+
+  // From now on the mill's axis positions `home_axis_steps` are the machine's home (the frames'
+  // step 0): recording starts.
+  void arm(const std::array<std::int64_t, kMillAxisCount>& home_axis_steps);
+  void axis_moved(Axis axis, const std::array<std::int64_t, kMillAxisCount>& axis_steps) override;
+  // Motion stopped: the current leg ends here.
+  void flush();
+
+  // Every corner is also written to `trace` as t_s,x_mm,y_mm,z_mm (null: none).
+  void set_trace(std::FILE* trace) { trace_ = trace; }
+
+  [[nodiscard]] const StockZmap& stock() const { return stock_; }
+  // The deepest the ball end mill's cutter (ball and flutes) went into the part's triangles along
+  // the whole path, mm; only a ball end mill is measured (measured() says).
+  [[nodiscard]] double max_gouge_mm() const { return max_gouge_mm_; }
+  [[nodiscard]] bool gouge_measured() const { return gouge_measured_; }
+  [[nodiscard]] std::uint64_t legs() const { return legs_; }
+  [[nodiscard]] const PathCorner& last_corner() const { return last_corner_; }
+
+  // The part's top surface over each Z-map cell (the floor where there is no part), the lowest the
+  // stock can be cut over each cell by this tool without entering the part, and what follows:
+  // computed once, at the end of a job.
+  struct Volumes {
+    double removed_mm3;
+    double gouge_mm3;         // stock cut below the part's top surface
+    double unmachined_mm3;    // stock this tool could have removed, still there
+    double reachable_mm3;     // all the stock this tool could have removed
+  };
+  [[nodiscard]] Volumes volumes() const;
+  [[nodiscard]] std::vector<double> part_heights() const;
+
+ private:
+  [[nodiscard]] Eigen::Vector3d world_of(const std::array<std::int64_t, kMillAxisCount>& axis_steps) const;
+  void finish_leg();
+  [[nodiscard]] double leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+  void corner(const Eigen::Vector3d& tip);
+
+  const tables::PartTables& part_;
+  motion::MachineFrames frames_;
+  std::function<double()> now_s_;
+  StockZmap stock_;
+  ToolProfile tool_;
+  std::array<std::int64_t, kMillAxisCount> home_{};
+  bool armed_ = false;
+  int leg_axis_ = -1;
+  Eigen::Vector3d leg_start_ = Eigen::Vector3d::Zero();
+  Eigen::Vector3d leg_end_ = Eigen::Vector3d::Zero();
+  double max_gouge_mm_ = 0.0;
+  bool gouge_measured_ = false;
+  std::uint64_t legs_ = 0;
+  std::FILE* trace_ = nullptr;
+  PathCorner last_corner_{0.0, Eigen::Vector3d::Zero()};
+};
+
+}  // namespace stencil::sim

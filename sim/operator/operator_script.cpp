@@ -1,0 +1,167 @@
+// Operator scripts: patterns over the stock, CSV files, and the walk between points.
+#include "sim/operator/operator_script.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace stencil::sim {
+
+Eigen::Vector3d OperatorScript::position_at(double t) const {
+  if (t_s.empty()) {
+    return Eigen::Vector3d::Zero();
+  }
+  if (t <= t_s.front()) {
+    return device_mm.front();
+  }
+  if (t >= t_s.back()) {
+    return device_mm.back();
+  }
+  const auto next = static_cast<std::size_t>(std::upper_bound(t_s.begin(), t_s.end(), t) - t_s.begin());
+  const double span = t_s[next] - t_s[next - 1];
+  const double f = span > 0.0 ? (t - t_s[next - 1]) / span : 1.0;
+  return device_mm[next - 1] + f * (device_mm[next] - device_mm[next - 1]);
+}
+
+Eigen::Vector2d OperatorScript::angles_at(double t) const {
+  if (t_s.empty()) {
+    return Eigen::Vector2d::Zero();
+  }
+  const auto next = static_cast<std::size_t>(std::upper_bound(t_s.begin(), t_s.end(), t) - t_s.begin());
+  if (next == 0) {
+    return angles_rad.front();
+  }
+  return angles_rad[std::min(next, angles_rad.size()) - 1];
+}
+
+void walk_to(OperatorScript& script, const Eigen::Vector3d& to_world_mm, double speed_mm_per_s,
+             double device_mm_per_world_mm) {
+  const Eigen::Vector3d to = device_mm_per_world_mm * to_world_mm;
+  if (script.t_s.empty()) {
+    script.t_s.push_back(0.0);
+    script.device_mm.push_back(to);
+    script.angles_rad.push_back(Eigen::Vector2d::Zero());
+    return;
+  }
+  const double distance_world = (to - script.device_mm.back()).norm() / device_mm_per_world_mm;
+  script.t_s.push_back(script.t_s.back() + distance_world / speed_mm_per_s);
+  script.device_mm.push_back(to);
+  script.angles_rad.push_back(Eigen::Vector2d::Zero());
+}
+
+OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
+                            double speed_mm_per_s, double scale, std::uint64_t seed) {
+  OperatorScript script;
+  const Eigen::Vector3d& low = stock.low_mm;
+  const Eigen::Vector3d& high = stock.high_mm;
+  const double above = high.z() + 1.0;
+  walk_to(script, home_world_mm, speed_mm_per_s, scale);
+  switch (pattern) {
+    case Pattern::Raster: {
+      walk_to(script, {low.x(), low.y(), above}, 4.0 * speed_mm_per_s, scale);
+      bool forward = true;
+      for (double level = high.z() - 1.0; level >= low.z() - 1e-9; level -= 1.0) {
+        const double pressed = level - 1.0;  // pushed 1 mm down: the stencil or the floor stops it
+        for (double x = low.x(); x <= high.x() + 1e-9; x += 1.0) {
+          walk_to(script, {x, forward ? low.y() : high.y(), pressed}, speed_mm_per_s, scale);
+          walk_to(script, {x, forward ? high.y() : low.y(), pressed}, speed_mm_per_s, scale);
+          forward = !forward;
+        }
+        // Back to the start corner over the top of what is left, for the next level.
+        walk_to(script, {high.x(), forward ? low.y() : high.y(), above}, 4.0 * speed_mm_per_s, scale);
+        walk_to(script, {low.x(), low.y(), above}, 4.0 * speed_mm_per_s, scale);
+        forward = true;
+      }
+      break;
+    }
+    case Pattern::Plunge:
+      for (double x = low.x() + 1.0; x < high.x(); x += 2.0) {
+        for (double y = low.y() + 1.0; y < high.y(); y += 2.0) {
+          walk_to(script, {x, y, above}, 4.0 * speed_mm_per_s, scale);
+          walk_to(script, {x, y, low.z() - 1.0}, speed_mm_per_s, scale);
+          walk_to(script, {x, y, above}, 4.0 * speed_mm_per_s, scale);
+        }
+      }
+      break;
+    case Pattern::Thinwall:
+      for (double z = high.z() - 0.5; z >= low.z(); z -= 1.5) {
+        walk_to(script, {low.x(), 0.5 * (low.y() + high.y()), z}, 4.0 * speed_mm_per_s, scale);
+        walk_to(script, {high.x(), 0.5 * (low.y() + high.y()), z}, 10.0 * speed_mm_per_s, scale);
+        walk_to(script, {0.5 * (low.x() + high.x()), low.y(), z}, 10.0 * speed_mm_per_s, scale);
+        walk_to(script, {0.5 * (low.x() + high.x()), high.y(), z}, 10.0 * speed_mm_per_s, scale);
+      }
+      break;
+    case Pattern::Random: {
+      std::mt19937_64 random(seed);
+      std::uniform_real_distribution<double> unit(0.0, 1.0);
+      for (int i = 0; i < 200; ++i) {
+        const Eigen::Vector3d to(low.x() + unit(random) * (high.x() - low.x()), low.y() + unit(random) * (high.y() - low.y()),
+                                 low.z() - 1.0 + unit(random) * (above - low.z() + 1.0));
+        walk_to(script, to, (0.5 + 2.0 * unit(random)) * speed_mm_per_s, scale);
+      }
+      break;
+    }
+  }
+  walk_to(script, {script.device_mm.back().x() / scale, script.device_mm.back().y() / scale, above}, 4.0 * speed_mm_per_s,
+          scale);
+  walk_to(script, home_world_mm, 4.0 * speed_mm_per_s, scale);
+  return script;
+}
+
+bool read_operator_csv(const std::string& path, OperatorScript& script, std::string& error) {
+  std::ifstream in(path);
+  if (!in) {
+    error = path + ": cannot be read";
+    return false;
+  }
+  std::string line;
+  int number = 0;
+  while (std::getline(in, line)) {
+    ++number;
+    if (line.empty() || line[0] == '#' || (number == 1 && line.rfind("t_s", 0) == 0)) {
+      continue;  // comments and a header line
+    }
+    std::vector<double> values;
+    std::stringstream fields(line);
+    std::string field;
+    while (std::getline(fields, field, ',')) {
+      std::size_t used = 0;
+      double value = 0.0;
+      try {
+        value = std::stod(field, &used);
+      } catch (...) {
+        used = 0;
+      }
+      while (used < field.size() && (field[used] == ' ' || field[used] == '\r')) {
+        ++used;
+      }
+      if (used == 0 || used != field.size() || !std::isfinite(value)) {
+        error = path + ": line " + std::to_string(number) + ": field " + std::to_string(values.size() + 1) + " '" + field +
+                "' is not a finite number";
+        return false;
+      }
+      values.push_back(value);
+    }
+    if (values.size() != 4 && values.size() != 6) {
+      error = path + ": line " + std::to_string(number) + ": " + std::to_string(values.size()) +
+              " fields; expected t_s,x_mm,y_mm,z_mm[,a_rad,b_rad]";
+      return false;
+    }
+    if (!script.t_s.empty() && !(values[0] > script.t_s.back())) {
+      error = path + ": line " + std::to_string(number) + ": t_s " + std::to_string(values[0]) +
+              " does not increase (the previous row's is " + std::to_string(script.t_s.back()) + ")";
+      return false;
+    }
+    script.t_s.push_back(values[0]);
+    script.device_mm.emplace_back(values[1], values[2], values[3]);
+    script.angles_rad.emplace_back(values.size() == 6 ? values[4] : 0.0, values.size() == 6 ? values[5] : 0.0);
+  }
+  if (script.t_s.empty()) {
+    error = path + ": no rows; expected t_s,x_mm,y_mm,z_mm[,a_rad,b_rad]";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace stencil::sim
