@@ -17,9 +17,16 @@ class FakeCy545Clock final : public hal::Clock {
   FakeCy545Clock(FakeCy545& fake, hal::MonotonicNs start_ns, double baud)
       : fake_(fake), now_(start_ns), byte_ns_(static_cast<hal::MonotonicNs>(10.0 * 1e9 / baud)) {}
 
-  // Time passes by the wire time of every byte that crossed the line since the last look.
+  // Time passes by the wire time of every byte that crossed the line since the last look, and while
+  // the driver waits on a chip that is busy (homing or moving) with a question in its buffer, until
+  // the chip is free to answer it: on the rig the driver's wait for the reply is that time.
   [[nodiscard]] hal::MonotonicNs now_ns() const override {
     fake_.step(now_);
+    for (int waited_ms = 0; waited_ms < kLongestWaitMs && fake_.chip().busy() && fake_.chip().receive_buffer_bytes() > 0;
+         ++waited_ms) {
+      now_ += 1'000'000;
+      fake_.step(now_);
+    }
     const PtyCounters& counters = fake_.pty_counters();
     const std::int64_t crossed = counters.bytes_read + counters.bytes_written;
     now_ += (crossed - bytes_seen_) * byte_ns_;
@@ -35,6 +42,8 @@ class FakeCy545Clock final : public hal::Clock {
   }
 
  private:
+  static constexpr int kLongestWaitMs = 120'000;  // longer than any seek: the driver's own bound decides
+
   FakeCy545& fake_;
   mutable hal::MonotonicNs now_;
   mutable std::int64_t bytes_seen_ = 0;

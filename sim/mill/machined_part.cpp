@@ -173,22 +173,30 @@ MachinedPart::Volumes MachinedPart::volumes() const {
     return grid[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)];
   };
   // The lowest tip over each cell that keeps the tool out of the part (and off the floor), then the
-  // lowest the tool's surface can come over each cell from any such tip: the reachable surface.
+  // lowest the tool's surface can come over each cell from any such tip: the reachable surface. The
+  // tool's footprint as offsets in cells with the cutter's height over each.
   const int reach = static_cast<int>(std::ceil(tool_.radius_mm / cell));
+  struct Offset {
+    int dc, dr;
+    double lift;
+  };
+  std::vector<Offset> footprint;
+  for (int dr = -reach; dr <= reach; ++dr) {
+    for (int dc = -reach; dc <= reach; ++dc) {
+      const double lift = tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc)));
+      if (std::isfinite(lift)) {
+        footprint.push_back({dc, dr, lift});
+      }
+    }
+  }
+  const auto inside = [&](int c, int r) { return r >= 0 && r < rows && c >= 0 && c < columns; };
   std::vector<double> tip(part.size(), floor);
   for (int row = 0; row < rows; ++row) {
     for (int column = 0; column < columns; ++column) {
       double lowest = floor;
-      for (int dr = -reach; dr <= reach; ++dr) {
-        for (int dc = -reach; dc <= reach; ++dc) {
-          const int r = row + dr, c = column + dc;
-          if (r < 0 || r >= rows || c < 0 || c >= columns) {
-            continue;
-          }
-          const double lift = tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc)));
-          if (std::isfinite(lift)) {
-            lowest = std::max(lowest, at(part, c, r) - lift);
-          }
+      for (const Offset& o : footprint) {
+        if (inside(column + o.dc, row + o.dr)) {
+          lowest = std::max(lowest, at(part, column + o.dc, row + o.dr) - o.lift);
         }
       }
       tip[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] = lowest;
@@ -198,13 +206,9 @@ MachinedPart::Volumes MachinedPart::volumes() const {
   for (int row = 0; row < rows; ++row) {
     for (int column = 0; column < columns; ++column) {
       double reachable = top;
-      for (int dr = -reach; dr <= reach; ++dr) {
-        for (int dc = -reach; dc <= reach; ++dc) {
-          const int r = row + dr, c = column + dc;
-          if (r < 0 || r >= rows || c < 0 || c >= columns) {
-            continue;
-          }
-          reachable = std::min(reachable, at(tip, c, r) + tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc))));
+      for (const Offset& o : footprint) {
+        if (inside(column + o.dc, row + o.dr)) {
+          reachable = std::min(reachable, at(tip, column + o.dc, row + o.dr) + o.lift);
         }
       }
       reachable = std::max(reachable, at(part, column, row));

@@ -7,6 +7,15 @@
 #include <sstream>
 
 namespace stencil::sim {
+namespace {
+
+// Moves between passes go in any direction: at 2/3 of the pass speed their |dx| + |dy| + |dz| stays
+// within the mill's step rate, so the virtual tool keeps up and the hand feels no pull.
+constexpr double kRepositionFactor = 2.0 / 3.0;
+// Thin-wall sweeps are meant to be too fast: the speed limit and the sweep check hold the tool.
+constexpr double kSweepFactor = 10.0;
+
+}  // namespace
 
 Eigen::Vector3d OperatorScript::position_at(double t) const {
   if (t_s.empty()) {
@@ -59,7 +68,7 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
   walk_to(script, home_world_mm, speed_mm_per_s, scale);
   switch (pattern) {
     case Pattern::Raster: {
-      walk_to(script, {low.x(), low.y(), above}, 4.0 * speed_mm_per_s, scale);
+      walk_to(script, {low.x(), low.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
       bool forward = true;
       for (double level = high.z() - 1.0; level >= low.z() - 1e-9; level -= 1.0) {
         const double pressed = level - 1.0;  // pushed 1 mm down: the stencil or the floor stops it
@@ -69,8 +78,8 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
           forward = !forward;
         }
         // Back to the start corner over the top of what is left, for the next level.
-        walk_to(script, {high.x(), forward ? low.y() : high.y(), above}, 4.0 * speed_mm_per_s, scale);
-        walk_to(script, {low.x(), low.y(), above}, 4.0 * speed_mm_per_s, scale);
+        walk_to(script, {high.x(), forward ? low.y() : high.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
+        walk_to(script, {low.x(), low.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
         forward = true;
       }
       break;
@@ -78,18 +87,18 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
     case Pattern::Plunge:
       for (double x = low.x() + 1.0; x < high.x(); x += 2.0) {
         for (double y = low.y() + 1.0; y < high.y(); y += 2.0) {
-          walk_to(script, {x, y, above}, 4.0 * speed_mm_per_s, scale);
+          walk_to(script, {x, y, above}, kRepositionFactor * speed_mm_per_s, scale);
           walk_to(script, {x, y, low.z() - 1.0}, speed_mm_per_s, scale);
-          walk_to(script, {x, y, above}, 4.0 * speed_mm_per_s, scale);
+          walk_to(script, {x, y, above}, kRepositionFactor * speed_mm_per_s, scale);
         }
       }
       break;
     case Pattern::Thinwall:
       for (double z = high.z() - 0.5; z >= low.z(); z -= 1.5) {
-        walk_to(script, {low.x(), 0.5 * (low.y() + high.y()), z}, 4.0 * speed_mm_per_s, scale);
-        walk_to(script, {high.x(), 0.5 * (low.y() + high.y()), z}, 10.0 * speed_mm_per_s, scale);
-        walk_to(script, {0.5 * (low.x() + high.x()), low.y(), z}, 10.0 * speed_mm_per_s, scale);
-        walk_to(script, {0.5 * (low.x() + high.x()), high.y(), z}, 10.0 * speed_mm_per_s, scale);
+        walk_to(script, {low.x(), 0.5 * (low.y() + high.y()), z}, kRepositionFactor * speed_mm_per_s, scale);
+        walk_to(script, {high.x(), 0.5 * (low.y() + high.y()), z}, kSweepFactor * speed_mm_per_s, scale);
+        walk_to(script, {0.5 * (low.x() + high.x()), low.y(), z}, kSweepFactor * speed_mm_per_s, scale);
+        walk_to(script, {0.5 * (low.x() + high.x()), high.y(), z}, kSweepFactor * speed_mm_per_s, scale);
       }
       break;
     case Pattern::Random: {
@@ -103,9 +112,9 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
       break;
     }
   }
-  walk_to(script, {script.device_mm.back().x() / scale, script.device_mm.back().y() / scale, above}, 4.0 * speed_mm_per_s,
+  walk_to(script, {script.device_mm.back().x() / scale, script.device_mm.back().y() / scale, above}, kRepositionFactor * speed_mm_per_s,
           scale);
-  walk_to(script, home_world_mm, 4.0 * speed_mm_per_s, scale);
+  walk_to(script, home_world_mm, kRepositionFactor * speed_mm_per_s, scale);
   return script;
 }
 

@@ -1,0 +1,231 @@
+// The simulation board's wiring and its fast run loop.
+//
+// On virtual time the cycle and the machine side take turns on one thread: the cycle runs period
+// after period until its time reaches the machine's; then the machine side runs one update, whose
+// link waits move the machine's clock (FakeCy545Clock), and with it the fake CY545 and the mill,
+// by as long as the serial line and the moves take. The machine only ever sees the handoffs of
+// cycles before its update, as on the rig, and nothing depends on the wall clock.
+#include "board/sim/sim_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+
+#include "firmware/control/controller.hpp"
+#include "firmware/control/loop_statistics.hpp"
+#include "firmware/control/machine_side.hpp"
+#include "hal/cy545/cy545_link.hpp"
+#include "hal/cy545/serial_port.hpp"
+#include "sim/cy545/fake_cy545.hpp"
+#include "sim/cy545/fake_cy545_clock.hpp"
+#include "sim/haptic_device/direct_haptic_device.hpp"
+#include "sim/mill/machined_part.hpp"
+#include "sim/mill/simulated_mill.hpp"
+
+namespace stencil::board::sim {
+namespace {
+
+constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
+constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
+constexpr double kBaud = 57600.0;
+
+motion::MachineFrames sim_frames() {
+  // Every axis counts into the workspace from its switch, so the world runs against all three.
+  return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
+          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), {-1, -1, -1}, 640.0};
+}
+
+Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
+  return {histogram.quantile_us(0.5), histogram.quantile_us(0.99), histogram.quantile_us(0.999),
+          static_cast<double>(histogram.max_ns()) / 1000.0};
+}
+
+double reachable_coverage(const tables::PartTables& part, const engine::TriangleSet& touched) {
+  if (part.header.reachable_triangle_count == 0) {
+    return 1.0;
+  }
+  std::uint32_t covered = 0;
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    covered += (part.triangle_flags[t] & tables::kTriangleReachable) != 0 && touched.contains(t) ? 1U : 0U;
+  }
+  return static_cast<double>(covered) / static_cast<double>(part.header.reachable_triangle_count);
+}
+
+}  // namespace
+
+stencil::sim::StockBox default_stock(const tables::PartTables& part) {
+  Eigen::Vector3d low = Eigen::Vector3d::Constant(1e300), high = Eigen::Vector3d::Constant(-1e300);
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    for (const tables::PackedPoint& v : part.triangles[t].vertices) {
+      const Eigen::Vector3d p(v.x_mm, v.y_mm, v.z_mm);
+      low = low.cwiseMin(p);
+      high = high.cwiseMax(p);
+    }
+  }
+  const Eigen::Vector3d workspace(part.header.workspace_mm[0], part.header.workspace_mm[1], part.header.workspace_mm[2]);
+  const Eigen::Vector3d margin(2.0, 2.0, 0.0);
+  return {(low - margin).cwiseMax(Eigen::Vector3d::Zero()).cwiseProduct(Eigen::Vector3d(1, 1, 0)),
+          (high + margin + Eigen::Vector3d(0, 0, 1.0)).cwiseMin(workspace)};
+}
+
+SimResult run_fast(const SimJob& job) {
+  SimResult result;
+  const tables::PartTables& part = *job.part;
+  const auto wall_start = std::chrono::steady_clock::now();
+  const motion::MachineFrames frames = sim_frames();
+
+  // The far side of the serial cable: the mill, its fake CY545 on a pty, the clock they follow.
+  stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
+  stencil::sim::cy545::FakeCy545 fake{mill, 0};
+  stencil::sim::cy545::FakeCy545Clock machine_clock{fake, 0, kBaud};
+  stencil::sim::MachinedPart machined{part, job.stock, frames,
+                                      [&fake] { return static_cast<double>(fake.chip().now_ns()) / 1e9; }};
+  machined.set_trace(job.trace);
+  mill.set_motion_observer(&machined);
+
+  // The controller's side: the driver, the rings, the cycle and the machine side.
+  hal::cy545::SerialPort port;
+  char port_error[256] = {};
+  if (!port.open(fake.slave_path().c_str(), port_error)) {
+    result.error = std::string("the fake CY545's pty: ") + port_error;
+    return result;
+  }
+  hal::cy545::Cy545Config link_config;
+  link_config.homing_rate = 20000;
+  hal::cy545::Cy545Link link(port, machine_clock, link_config);
+
+  auto commands = std::make_unique<control::CommandRing>();
+  auto machine_events = std::make_unique<control::MachineEventRing>();
+  auto handoffs = std::make_unique<control::MachineHandoffRing>();
+  auto telemetry = std::make_unique<control::TelemetryRing>();
+  auto journal = std::make_unique<control::JournalRing>();
+  stencil::sim::DirectHapticDevice device{hal::kCornerOriginHapticRange};
+
+  control::ControllerConfig config;
+  config.frames = frames;
+  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
+  config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
+  config.home_tip_mm = frames.home_world_mm;
+  config.count_overruns = false;  // virtual time: lateness means nothing
+  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  auto controller = std::make_unique<control::Controller>(
+      part, device, control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
+  if (!controller->ready()) {
+    result.error = "the tables' tool could not be grown for the touched set";
+    return result;
+  }
+  const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
+  auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, *handoffs, *machine_events);
+  if (!machine->start(machine_clock.now_ns() + 120'000'000'000)) {
+    result.error = std::string("the machine did not start: ") + link.last_error();
+    return result;
+  }
+  result.started = true;
+  machined.arm({mill.axis_position_steps(stencil::sim::Axis::x), mill.axis_position_steps(stencil::sim::Axis::y),
+                mill.axis_position_steps(stencil::sim::Axis::z)});
+
+  // The operator's hand, where the script starts.
+  stencil::sim::OperatorHand hand;
+  hand.handle_mm = job.script.position_at(0.0);
+  const hal::MonotonicNs start_ns = (machine_clock.now_ns() / kPeriodNs + 1) * kPeriodNs;
+  hal::MonotonicNs cycle_ns = start_ns;
+  hal::MonotonicNs next_update_ns = start_ns;
+  const double duration_s = job.duration_s > 0.0 ? job.duration_s : job.script.duration_s();
+  // After the script, the mill is given up to this long to catch up with the virtual tool.
+  constexpr double kCatchUpS = 30.0;
+  control::MicrosecondHistogram compute;
+  std::uint32_t sample_counter = 0;
+  double next_progress_s = 10.0;
+  bool stop_after_update = false;
+  for (;;) {
+    if (cycle_ns >= next_update_ns && cycle_ns >= machine_clock.now_ns()) {
+      machine_clock.sleep_until_ns(cycle_ns);
+      machine->update(machine_clock.now_ns() + 2 * kUpdateNs);
+      machined.flush();
+      next_update_ns += kUpdateNs;
+      if (stop_after_update) {
+        break;
+      }
+      continue;
+    }
+    const double t_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
+    const hal::HapticCommand& rendered = device.rendered();
+    hand.step(job.script.position_at(t_s),
+              Eigen::Vector3d(rendered.force_n[0], rendered.force_n[1], rendered.force_n[2]));
+    const Eigen::Vector2d angles = job.script.angles_at(t_s);
+    device.publish({{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {angles.x(), angles.y()},
+                    ++sample_counter, hal::haptic_status::kForceApplied, sample_counter});
+    const auto wall_before = std::chrono::steady_clock::now();
+    const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
+    compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
+    controller->finish(cycle_ns, cycle_ns + kPeriodNs);
+    control::JournalRecord record{};
+    while (journal->pop(record)) {
+    }
+    control::Telemetry frame{};
+    while (telemetry->pop(frame)) {
+    }
+    cycle_ns += kPeriodNs;
+    if (status == control::CycleStatus::SafeState) {
+      stop_after_update = true;  // one more machine update: it holds and stops the mill
+      next_update_ns = std::min(next_update_ns, cycle_ns);
+      continue;
+    }
+    if (controller->statistics().cycles % 1000 == 0) {
+      const double coverage = reachable_coverage(part, controller->touched());
+      if (job.progress && t_s >= next_progress_s) {
+        job.progress(t_s, coverage);
+        next_progress_s += 10.0;
+      }
+      const bool drained = machine->path_left() <= 1 && machine->at_goal();
+      if (job.until_complete && coverage >= 1.0 && drained) {
+        result.complete = true;
+        break;
+      }
+      if (t_s >= duration_s && (drained || t_s >= duration_s + kCatchUpS)) {
+        break;
+      }
+    }
+  }
+  machined.flush();
+
+  const stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
+  result.cycles = controller->statistics().cycles;
+  result.overruns = controller->statistics().overruns;
+  result.wakeup_latency_us = {0.0, 0.0, 0.0, 0.0};
+  result.compute_us = quantiles_of(compute);
+  result.simulated_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
+  result.gouge_max_depth_mm = machined.max_gouge_mm();
+  result.gouge_measured = machined.gouge_measured();
+  result.gouge_volume_mm3 = volumes.gouge_mm3;
+  result.removed_volume_mm3 = volumes.removed_mm3;
+  result.unmachined_volume_mm3 = volumes.unmachined_mm3;
+  result.reachable_volume_mm3 = volumes.reachable_mm3;
+  result.coverage_fraction = reachable_coverage(part, controller->touched());
+  result.max_force_n = controller->max_force_n();
+  result.max_offset_mm = controller->max_offset_mm();
+  result.machine_updates = machine->statistics().updates;
+  result.machine_take_ups = machine->statistics().take_ups;
+  result.machine_max_lag_mm = machine->statistics().max_lag_mm;
+  result.safe_state = controller->safe_reason();
+  if (machine->fault() != hal::MachineFault::None || machine->state() == control::MachineSideState::Stopped) {
+    result.machine_error = link.last_error();
+  }
+  const stencil::sim::StockZmap& stock = machined.stock();
+  result.columns = stock.columns();
+  result.rows = stock.rows();
+  result.cell_mm = stock.cell_mm();
+  for (int row = 0; row < stock.rows(); ++row) {
+    for (int column = 0; column < stock.columns(); ++column) {
+      result.stock_heights.push_back(stock.height(column, row));
+    }
+  }
+  result.part_heights = machined.part_heights();
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  mill.set_motion_observer(nullptr);
+  return result;
+}
+
+}  // namespace stencil::board::sim

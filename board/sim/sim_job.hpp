@@ -1,0 +1,85 @@
+// The host simulation's board: the controller's cycle and machine side wired to the simulated
+// device (in process), the fake CY545 on a pseudo-terminal, the simulated mill and its stock, and
+// the simulated operator; and the fast run loop that drives them on virtual time.
+#pragma once
+
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "firmware/control/safe_state.hpp"
+#include "firmware/tables/part_tables.hpp"
+#include "sim/mill/stock_zmap.hpp"
+#include "sim/operator/operator_script.hpp"
+
+namespace stencil::board::sim {
+
+// The simulation board's frames: world = device / 10, device space [0,500]x[0,250]x[0,250]; the
+// machine homes with the tool at the workspace's far top corner (its X and Y switches at the
+// table's travel end, Z at the top), so every axis counts from there into the workspace.
+inline constexpr double kDeviceMmPerWorldMm = 10.0;
+inline constexpr double kHomeWorldMm[3] = {50.0, 25.0, 25.0};
+// What the mill really follows: 1.4 mm/s per axis and 1000 steps/s are its stepping, but each update
+// also spends about 15 ms of its 33 on the serial line, so the virtual tool is held to 1 mm/s (per
+// axis and |dx| + |dy| + |dz|), and the scripted hand moves a little slower than that.
+inline constexpr double kVirtualToolSpeedMmPerS = 1.0;
+inline constexpr double kOperatorSpeedMmPerS = 0.8;
+
+struct SimJob {
+  const tables::PartTables* part = nullptr;
+  stencil::sim::StockBox stock{};
+  stencil::sim::OperatorScript script;
+  double duration_s = 0.0;      // 0: the script's own length
+  bool until_complete = false;  // end once every reachable triangle is touched and the mill has caught up
+  std::FILE* trace = nullptr;   // the mill's true path corners, t_s,x_mm,y_mm,z_mm
+  std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
+};
+
+struct Quantiles {
+  double p50, p99, p999, max;
+};
+
+struct SimResult {
+  bool started = false;          // false: the machine never came up (see error)
+  std::string error;
+  std::uint64_t cycles = 0;
+  std::uint64_t overruns = 0;
+  Quantiles wakeup_latency_us{};  // on virtual time: always 0
+  Quantiles compute_us{};         // wall clock: the cycle's own work
+  double simulated_s = 0.0;
+  double wall_s = 0.0;
+  double gouge_max_depth_mm = 0.0;
+  bool gouge_measured = false;
+  double gouge_volume_mm3 = 0.0;
+  double removed_volume_mm3 = 0.0;
+  double unmachined_volume_mm3 = 0.0;
+  double reachable_volume_mm3 = 0.0;
+  double coverage_fraction = 0.0;  // reachable triangles touched
+  double max_force_n = 0.0;
+  double max_offset_mm = 0.0;
+  std::uint64_t machine_updates = 0;
+  std::uint64_t machine_take_ups = 0;
+  double machine_max_lag_mm = 0.0;
+  control::SafeReason safe_state = control::SafeReason::None;
+  std::string machine_error;  // the machine link's last error, when it faulted
+  bool complete = false;  // until_complete met
+  // The machined stock and the part's top, for the picture: heights per cell, row-major.
+  int columns = 0, rows = 0;
+  double cell_mm = 0.0;
+  std::vector<double> stock_heights, part_heights;
+};
+
+// Runs the job on virtual time, as fast as the machine allows; the same job gives the same result
+// apart from the wall-clock fields (compute_us, wall_s).
+[[nodiscard]] SimResult run_fast(const SimJob& job);
+
+// The default stock for a part: its bounding box grown by 2 mm on each side in x and y (within the
+// workspace), from the floor to 1 mm above the part's top.
+[[nodiscard]] stencil::sim::StockBox default_stock(const tables::PartTables& part);
+
+}  // namespace stencil::board::sim

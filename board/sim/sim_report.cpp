@@ -1,0 +1,134 @@
+// Report, summary and picture of a simulated job.
+#include "board/sim/sim_report.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include <nlohmann/json.hpp>
+
+namespace stencil::board::sim {
+namespace {
+
+nlohmann::json quantiles_json(const Quantiles& q) {
+  return {{"p50", q.p50}, {"p99", q.p99}, {"p999", q.p999}, {"max", q.max}};
+}
+
+}  // namespace
+
+bool write_report_json(const std::string& path, const SimResult& r, std::string& error) {
+  nlohmann::json report = {
+      {"cycles", r.cycles},
+      {"overruns", r.overruns},
+      {"simulated_s", r.simulated_s},
+      {"wall_s", r.wall_s},
+      {"wakeup_latency_us", quantiles_json(r.wakeup_latency_us)},
+      {"compute_us", quantiles_json(r.compute_us)},
+      {"gouge", {{"max_depth_mm", r.gouge_measured ? nlohmann::json(r.gouge_max_depth_mm) : nlohmann::json(nullptr)},
+                 {"volume_mm3", r.gouge_volume_mm3}}},
+      {"removed", {{"volume_mm3", r.removed_volume_mm3}}},
+      {"unmachined",
+       {{"volume_mm3", r.unmachined_volume_mm3},
+        {"fraction", r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0},
+        {"reachable_volume_mm3", r.reachable_volume_mm3}}},
+      {"coverage_fraction", r.coverage_fraction},
+      {"complete", r.complete},
+      {"max_force_n", r.max_force_n},
+      {"max_offset_mm", r.max_offset_mm},
+      {"machine", {{"updates", r.machine_updates}, {"take_ups", r.machine_take_ups}, {"max_lag_mm", r.machine_max_lag_mm},
+                   {"error", r.machine_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.machine_error)}}},
+      {"safe_state", r.safe_state == control::SafeReason::None ? nlohmann::json(nullptr)
+                                                                : nlohmann::json(control::safe_reason_name(r.safe_state))},
+  };
+  std::ofstream out(path);
+  out << report.dump(2) << '\n';
+  if (!out) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  return true;
+}
+
+std::string summary(const SimResult& r) {
+  char text[1024];
+  const double fraction = r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0;
+  std::snprintf(text, sizeof text,
+                "simulated %.1f s in %.1f s (%llu cycles, %llu machine updates)\n"
+                "gouge: %s mm deepest, %.3f mm3 under the part's top\n"
+                "stock removed %.1f mm3; unmachined %.2f mm3 = %.2f %% of what this tool can reach\n"
+                "coverage %.1f %% of reachable triangles; max force %.2f N; max offset %.3f mm; max machine lag %.3f mm\n"
+                "cycle compute p50 %.1f us, p99.9 %.1f us, max %.1f us (wall clock)\n"
+                "safe state: %s\n",
+                r.simulated_s, r.wall_s, static_cast<unsigned long long>(r.cycles),
+                static_cast<unsigned long long>(r.machine_updates),
+                r.gouge_measured ? std::to_string(r.gouge_max_depth_mm).c_str() : "not measured (not a ball end mill)",
+                r.gouge_volume_mm3, r.removed_volume_mm3, r.unmachined_volume_mm3, 100.0 * fraction,
+                100.0 * r.coverage_fraction, r.max_force_n, r.max_offset_mm, r.machine_max_lag_mm, r.compute_us.p50,
+                r.compute_us.p999, r.compute_us.max,
+                r.safe_state == control::SafeReason::None ? "none" : control::safe_reason_name(r.safe_state));
+  std::string out = text;
+  if (!r.machine_error.empty()) {
+    out += "machine: " + r.machine_error + "\n";
+  }
+  return out;
+}
+
+bool write_picture_svg(const std::string& path, const SimResult& r, std::string& error) {
+  // Blocks of cells, so the picture stays small: at most about 200 blocks across.
+  const int block = std::max(1, std::max(r.columns, r.rows) / 200);
+  const int columns = (r.columns + block - 1) / block, rows = (r.rows + block - 1) / block;
+  const double size = 4.0;  // px per block
+  double low = 1e300, high = -1e300;
+  for (const double h : r.stock_heights) {
+    low = std::min(low, h);
+    high = std::max(high, h);
+  }
+  for (const double h : r.part_heights) {
+    high = std::max(high, h);
+  }
+  const double span = high > low ? high - low : 1.0;
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (out == nullptr) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  const double width = 2.0 * columns * size + 3.0 * 10.0;
+  const double height = rows * size + 40.0;
+  std::fprintf(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" font-family=\"sans-serif\" font-size=\"12\">\n",
+               width, height);
+  std::fprintf(out, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
+  std::fprintf(out, "<text x=\"10\" y=\"16\">stock as machined (darker is lower; red: cut below the part)</text>\n");
+  std::fprintf(out, "<text x=\"%.0f\" y=\"16\">the part's top</text>\n", 20.0 + columns * size);
+  for (int panel = 0; panel < 2; ++panel) {
+    const std::vector<double>& grid = panel == 0 ? r.stock_heights : r.part_heights;
+    const double x0 = 10.0 + panel * (columns * size + 10.0);
+    for (int br = 0; br < rows; ++br) {
+      for (int bc = 0; bc < columns; ++bc) {
+        double value = -1e300, gouge = 0.0;
+        for (int row = br * block; row < std::min(r.rows, (br + 1) * block); ++row) {
+          for (int column = bc * block; column < std::min(r.columns, (bc + 1) * block); ++column) {
+            const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(r.columns) +
+                                  static_cast<std::size_t>(column);
+            value = std::max(value, grid[i]);
+            gouge = std::max(gouge, r.part_heights[i] - r.stock_heights[i]);
+          }
+        }
+        const int grey = static_cast<int>(40.0 + 200.0 * std::clamp((value - low) / span, 0.0, 1.0));
+        const bool warn = panel == 0 && gouge > 0.005;
+        // Rows run up the picture as y runs up the world.
+        std::fprintf(out, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"%s\"/>\n", x0 + bc * size,
+                     30.0 + (rows - 1 - br) * size, size, size,
+                     warn ? "#e0201c" : ("rgb(" + std::to_string(grey) + "," + std::to_string(grey) + "," + std::to_string(grey) + ")").c_str());
+      }
+    }
+  }
+  std::fprintf(out, "</svg>\n");
+  if (std::fclose(out) != 0) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace stencil::board::sim

@@ -1,0 +1,209 @@
+// stencil-sim: the controller's cycle and machine side against the simulated device, the fake CY545
+// on a pseudo-terminal and the simulated mill, on the baked-in sample part or a table file; reports
+// gouges, coverage and loop timing.
+#include <cstdio>
+#include <fstream>
+#include <iostream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include "board/sim/sim_job.hpp"
+#include "board/sim/sim_report.hpp"
+#include "firmware/tables/table_loader.hpp"
+
+// The baked-in sample part (the hex prism), linked into its own read-only section.
+extern const unsigned char stencil_table_hex_prism[];
+extern const std::size_t stencil_table_hex_prism_size;
+
+namespace {
+
+using namespace stencil;
+
+constexpr int kExitDone = 0;
+constexpr int kExitBadInput = 2;
+constexpr int kExitSafeState = 3;
+
+int bad_input(const std::string& message) {
+  std::fprintf(stderr, "stencil-sim: %s\n", message.c_str());
+  return kExitBadInput;
+}
+
+// "X0,Y0,Z0,X1,Y1,Z1" in world mm, inside the workspace, low below high.
+bool parse_stock(const std::string& text, const tables::PartTables& part, sim::StockBox& stock, std::string& error) {
+  std::vector<double> values;
+  std::stringstream fields(text);
+  std::string field;
+  while (std::getline(fields, field, ',')) {
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+      value = std::stod(field, &used);
+    } catch (...) {
+      used = 0;
+    }
+    if (used == 0 || used != field.size() || !std::isfinite(value)) {
+      error = "--stock " + text + ": '" + field + "' is not a number; expected X0,Y0,Z0,X1,Y1,Z1 in mm";
+      return false;
+    }
+    values.push_back(value);
+  }
+  if (values.size() != 6) {
+    error = "--stock " + text + ": " + std::to_string(values.size()) + " numbers; expected X0,Y0,Z0,X1,Y1,Z1 in mm";
+    return false;
+  }
+  stock = {{values[0], values[1], values[2]}, {values[3], values[4], values[5]}};
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!(stock.low_mm[axis] < stock.high_mm[axis]) || stock.low_mm[axis] < 0.0 ||
+        stock.high_mm[axis] > part.header.workspace_mm[axis]) {
+      error = "--stock " + text + ": axis " + "xyz"[axis] + " must have 0 <= low < high <= the workspace's " +
+              std::to_string(part.header.workspace_mm[axis]) + " mm";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "stencil-sim: the haptic stencil controller's cycle and machine side against a simulated operator and\n"
+      "device, the fake CY545 stepper controller on a pseudo-terminal and a simulated mill that removes\n"
+      "material; reports gouges, coverage and loop timing. Exit status: 0 done, 2 bad input, 3 ended in a\n"
+      "safe state."};
+  std::string tables_path;
+  std::string operator_path;
+  std::string pattern_name = "raster";
+  std::uint64_t seed = 1;
+  double duration_s = 0.0;
+  bool fast = false;
+  std::string report_path = "stencil-sim-report.json";
+  bool until_complete = false;
+  std::string stock_text;
+  std::string trace_path;
+  std::string transport = "direct";
+  app.add_option("--tables", tables_path, "the part's .stbl (default: the baked-in hex prism, ball end mill d = 3 mm)");
+  app.add_option("--operator", operator_path, "the operator's script: CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] in device space");
+  app.add_option("--pattern", pattern_name, "the operator's pattern when there is no --operator file")
+      ->check(CLI::IsMember({"raster", "plunge", "thinwall", "random"}))
+      ->capture_default_str();
+  app.add_option("--seed", seed, "the random pattern's seed")->capture_default_str();
+  app.add_option("--duration", duration_s, "simulated seconds to run (default: the script's length)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--fast", fast, "virtual clock, as fast as the machine allows, deterministic (the only mode built so far)");
+  app.add_option("--report", report_path, "the JSON report; the picture goes beside it as .svg")->capture_default_str();
+  app.add_flag("--until-complete", until_complete,
+               "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
+  app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the part's box grown by 2 mm)");
+  app.add_option("--trace", trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
+  app.add_option("--haptic-transport", transport, "how the cycle reaches the simulated device (only direct is built so far)")
+      ->check(CLI::IsMember({"direct", "pio", "can"}))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
+  }
+  if (!fast) {
+    return bad_input("real-time mode (--speed) is not built yet: pass --fast");
+  }
+  if (transport != "direct") {
+    return bad_input("--haptic-transport " + transport + " is not built yet: use direct");
+  }
+
+  // The part: a table file read into memory, or the baked-in section used in place.
+  std::vector<unsigned char> file_bytes;
+  tables::PartTables part{};
+  if (tables_path.empty()) {
+    const tables::TableLoadResult loaded =
+        tables::load_tables({reinterpret_cast<const std::byte*>(stencil_table_hex_prism), stencil_table_hex_prism_size}, part);
+    if (!loaded.ok) {
+      return bad_input(std::string("the baked-in table does not load: ") + loaded.field);
+    }
+  } else {
+    std::ifstream in(tables_path, std::ios::binary);
+    if (!in) {
+      return bad_input(tables_path + ": cannot be read");
+    }
+    file_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    const tables::TableLoadResult loaded =
+        tables::load_tables({reinterpret_cast<const std::byte*>(file_bytes.data()), file_bytes.size()}, part);
+    if (!loaded.ok) {
+      return bad_input(tables_path + ": not a valid table: " + loaded.field);
+    }
+  }
+
+  board::sim::SimJob job;
+  job.part = &part;
+  job.stock = board::sim::default_stock(part);
+  std::string error;
+  if (!stock_text.empty() && !parse_stock(stock_text, part, job.stock, error)) {
+    return bad_input(error);
+  }
+  const Eigen::Vector3d home(board::sim::kHomeWorldMm[0], board::sim::kHomeWorldMm[1], board::sim::kHomeWorldMm[2]);
+  if (!operator_path.empty()) {
+    if (!sim::read_operator_csv(operator_path, job.script, error)) {
+      return bad_input(error);
+    }
+  } else {
+    const sim::Pattern pattern = pattern_name == "raster"  ? sim::Pattern::Raster
+                                 : pattern_name == "plunge" ? sim::Pattern::Plunge
+                                 : pattern_name == "thinwall" ? sim::Pattern::Thinwall
+                                                              : sim::Pattern::Random;
+    job.script = sim::make_pattern(pattern, job.stock, home, board::sim::kOperatorSpeedMmPerS,
+                                   board::sim::kDeviceMmPerWorldMm, seed);
+  }
+  job.duration_s = duration_s;
+  job.until_complete = until_complete;
+  std::FILE* trace = nullptr;
+  if (!trace_path.empty()) {
+    trace = std::fopen(trace_path.c_str(), "w");
+    if (trace == nullptr) {
+      return bad_input(trace_path + ": cannot be written");
+    }
+    std::fprintf(trace, "t_s,x_mm,y_mm,z_mm\n");
+    job.trace = trace;
+  }
+  if (isatty(STDERR_FILENO) != 0) {
+    job.progress = [&](double t_s, double coverage) {
+      std::fprintf(stderr, "\rstencil-sim: %.0f of %.0f simulated s, coverage %.1f %%   ", t_s, job.script.duration_s(),
+                   100.0 * coverage);
+    };
+  }
+  std::printf("stencil-sim: %s, %s pattern over the stock [%.1f,%.1f]x[%.1f,%.1f]x[%.1f,%.1f] mm, %.0f simulated s\n",
+              tables_path.empty() ? "the baked-in hex prism" : tables_path.c_str(),
+              operator_path.empty() ? pattern_name.c_str() : operator_path.c_str(), job.stock.low_mm.x(),
+              job.stock.high_mm.x(), job.stock.low_mm.y(), job.stock.high_mm.y(), job.stock.low_mm.z(),
+              job.stock.high_mm.z(), job.script.duration_s());
+  std::fflush(stdout);
+
+  const board::sim::SimResult result = board::sim::run_fast(job);
+  if (job.progress) {
+    std::fprintf(stderr, "\n");
+  }
+  if (trace != nullptr) {
+    std::fclose(trace);
+  }
+  if (!result.started) {
+    std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
+    return kExitSafeState;
+  }
+  std::printf("%s", board::sim::summary(result).c_str());
+  const std::string picture_path =
+      (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
+           ? report_path.substr(0, report_path.size() - 5)
+           : report_path) +
+      ".svg";
+  if (!board::sim::write_report_json(report_path, result, error) ||
+      !board::sim::write_picture_svg(picture_path, result, error)) {
+    return bad_input(error);
+  }
+  std::printf("report: %s\npicture: %s\n", report_path.c_str(), picture_path.c_str());
+  return result.safe_state == control::SafeReason::None ? kExitDone : kExitSafeState;
+}
