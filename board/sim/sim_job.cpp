@@ -69,6 +69,17 @@ stencil::sim::StockBox default_stock(const tables::PartTables& part) {
           (high + margin + Eigen::Vector3d(0, 0, 1.0)).cwiseMin(workspace)};
 }
 
+std::function<double(double, double)> touch_tip_of(const tables::PartTables& part, const stencil::sim::StockBox& stock) {
+  auto grid = std::make_shared<stencil::sim::StockZmap>(stock, 0.05);
+  auto tips = std::make_shared<std::vector<double>>(
+      stencil::sim::lowest_tips(*grid, stencil::sim::part_top_heights(part, *grid), stencil::sim::ToolProfile::of(part.tool.spec)));
+  return [grid, tips](double x, double y) {
+    const int column = std::clamp(static_cast<int>((x - grid->box().low_mm.x()) / grid->cell_mm()), 0, grid->columns() - 1);
+    const int row = std::clamp(static_cast<int>((y - grid->box().low_mm.y()) / grid->cell_mm()), 0, grid->rows() - 1);
+    return (*tips)[static_cast<std::size_t>(row) * static_cast<std::size_t>(grid->columns()) + static_cast<std::size_t>(column)];
+  };
+}
+
 SimResult run_fast(const SimJob& job) {
   SimResult result;
   const tables::PartTables& part = *job.part;

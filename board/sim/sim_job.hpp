@@ -78,6 +78,11 @@ struct SimResult {
 // apart from the wall-clock fields (compute_us, wall_s).
 [[nodiscard]] SimResult run_fast(const SimJob& job);
 
+// The lowest the part's tool can have its tip over (x, y) without entering the part, from the
+// part's top over a 0.05 mm grid of the stock (the scripted operator's idea of the part).
+[[nodiscard]] std::function<double(double, double)> touch_tip_of(const tables::PartTables& part,
+                                                                  const stencil::sim::StockBox& stock);
+
 // The default stock for a part: its bounding box grown by 2 mm on each side in x and y (within the
 // workspace), from the floor to 1 mm above the part's top.
 [[nodiscard]] stencil::sim::StockBox default_stock(const tables::PartTables& part);

@@ -157,7 +157,7 @@ int main(int argc, char** argv) {
                                  : pattern_name == "thinwall" ? sim::Pattern::Thinwall
                                                               : sim::Pattern::Random;
     job.script = sim::make_pattern(pattern, job.stock, home, board::sim::kOperatorSpeedMmPerS,
-                                   board::sim::kDeviceMmPerWorldMm, seed);
+                                   board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock));
   }
   job.duration_s = duration_s;
   job.until_complete = until_complete;

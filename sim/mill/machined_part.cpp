@@ -11,6 +11,27 @@
 namespace stencil::sim {
 namespace {
 
+// The tool's footprint as offsets in cells, with the cutter's height over each.
+struct Offset {
+  int dc, dr;
+  double lift;
+};
+
+std::vector<Offset> footprint_of(const StockZmap& grid, const ToolProfile& tool) {
+  const double cell = grid.cell_mm();
+  const int reach = static_cast<int>(std::ceil(tool.radius_mm / cell));
+  std::vector<Offset> footprint;
+  for (int dr = -reach; dr <= reach; ++dr) {
+    for (int dc = -reach; dc <= reach; ++dc) {
+      const double lift = tool.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc)));
+      if (std::isfinite(lift)) {
+        footprint.push_back({dc, dr, lift});
+      }
+    }
+  }
+  return footprint;
+}
+
 Eigen::Vector3d vertex(const tables::PackedTriangle& triangle, int i) {
   const tables::PackedPoint& v = triangle.vertices[static_cast<std::size_t>(i)];
   return {v.x_mm, v.y_mm, v.z_mm};
@@ -28,6 +49,29 @@ double triangle_triangle_distance(const std::array<Eigen::Vector3d, 3>& p, const
 }
 
 }  // namespace
+
+std::vector<double> lowest_tips(const StockZmap& grid, const std::vector<double>& part_heights,
+                                const ToolProfile& tool) {
+  const int columns = grid.columns(), rows = grid.rows();
+  const double floor = grid.box().low_mm.z();
+  const std::vector<Offset> footprint = footprint_of(grid, tool);
+  std::vector<double> tip(part_heights.size(), floor);
+  for (int row = 0; row < rows; ++row) {
+    for (int column = 0; column < columns; ++column) {
+      double lowest = floor;
+      for (const Offset& o : footprint) {
+        const int c = column + o.dc, r = row + o.dr;
+        if (r >= 0 && r < rows && c >= 0 && c < columns) {
+          lowest = std::max(lowest, part_heights[static_cast<std::size_t>(r) * static_cast<std::size_t>(columns) +
+                                                 static_cast<std::size_t>(c)] -
+                                        o.lift);
+        }
+      }
+      tip[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] = lowest;
+    }
+  }
+  return tip;
+}
 
 MachinedPart::MachinedPart(const tables::PartTables& part, const StockBox& stock, const motion::MachineFrames& frames,
                            std::function<double()> now_s)
@@ -127,7 +171,7 @@ double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3
   return deepest;
 }
 
-std::vector<double> MachinedPart::part_heights() const {
+std::vector<double> part_top_heights(const tables::PartTables& part_, const StockZmap& stock_) {
   // The part's top over each cell centre: the highest triangle above it (the part stands on the
   // floor; a cell with no part over it is the floor's height).
   std::vector<double> heights(static_cast<std::size_t>(stock_.columns()) * static_cast<std::size_t>(stock_.rows()),
@@ -163,6 +207,8 @@ std::vector<double> MachinedPart::part_heights() const {
   return heights;
 }
 
+std::vector<double> MachinedPart::part_heights() const { return part_top_heights(part_, stock_); }
+
 MachinedPart::Volumes MachinedPart::volumes() const {
   const std::vector<double> part = part_heights();
   const int columns = stock_.columns(), rows = stock_.rows();
@@ -172,36 +218,11 @@ MachinedPart::Volumes MachinedPart::volumes() const {
   const auto at = [&](const std::vector<double>& grid, int column, int row) -> double {
     return grid[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)];
   };
-  // The lowest tip over each cell that keeps the tool out of the part (and off the floor), then the
-  // lowest the tool's surface can come over each cell from any such tip: the reachable surface. The
-  // tool's footprint as offsets in cells with the cutter's height over each.
-  const int reach = static_cast<int>(std::ceil(tool_.radius_mm / cell));
-  struct Offset {
-    int dc, dr;
-    double lift;
-  };
-  std::vector<Offset> footprint;
-  for (int dr = -reach; dr <= reach; ++dr) {
-    for (int dc = -reach; dc <= reach; ++dc) {
-      const double lift = tool_.height_at(cell * std::sqrt(static_cast<double>(dr * dr + dc * dc)));
-      if (std::isfinite(lift)) {
-        footprint.push_back({dc, dr, lift});
-      }
-    }
-  }
+  const std::vector<double> tip = lowest_tips(stock_, part, tool_);
+  // The lowest the tool's surface can come over each cell from any of those tips: the reachable
+  // surface.
+  const std::vector<Offset> footprint = footprint_of(stock_, tool_);
   const auto inside = [&](int c, int r) { return r >= 0 && r < rows && c >= 0 && c < columns; };
-  std::vector<double> tip(part.size(), floor);
-  for (int row = 0; row < rows; ++row) {
-    for (int column = 0; column < columns; ++column) {
-      double lowest = floor;
-      for (const Offset& o : footprint) {
-        if (inside(column + o.dc, row + o.dr)) {
-          lowest = std::max(lowest, at(part, column + o.dc, row + o.dr) - o.lift);
-        }
-      }
-      tip[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] = lowest;
-    }
-  }
   Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0};
   for (int row = 0; row < rows; ++row) {
     for (int column = 0; column < columns; ++column) {

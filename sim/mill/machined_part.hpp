@@ -18,6 +18,15 @@
 
 namespace stencil::sim {
 
+// The part's top over each cell centre of `grid` (the floor's height where there is no part):
+// the highest of the part's triangles above it, row-major.
+[[nodiscard]] std::vector<double> part_top_heights(const tables::PartTables& part, const StockZmap& grid);
+
+// Over the cells of `grid`, given the part's top over each (part_heights, row-major): the lowest the
+// tool's tip can be over each cell without the tool entering the part or going below the floor.
+[[nodiscard]] std::vector<double> lowest_tips(const StockZmap& grid, const std::vector<double>& part_heights,
+                                              const ToolProfile& tool);
+
 // One corner of the path the mill followed: where the moving axis changed or motion stopped.
 struct PathCorner {
   double t_s;
@@ -62,6 +71,7 @@ class MachinedPart final : public MillMotionObserver {
   };
   [[nodiscard]] Volumes volumes() const;
   [[nodiscard]] std::vector<double> part_heights() const;
+  [[nodiscard]] const ToolProfile& tool() const { return tool_; }
 
  private:
   [[nodiscard]] Eigen::Vector3d world_of(const std::array<std::int64_t, kMillAxisCount>& axis_steps) const;

@@ -60,7 +60,8 @@ void walk_to(OperatorScript& script, const Eigen::Vector3d& to_world_mm, double 
 }
 
 OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
-                            double speed_mm_per_s, double scale, std::uint64_t seed) {
+                            double speed_mm_per_s, double scale, std::uint64_t seed,
+                            const std::function<double(double, double)>& touch_tip) {
   OperatorScript script;
   const Eigen::Vector3d& low = stock.low_mm;
   const Eigen::Vector3d& high = stock.high_mm;
@@ -69,18 +70,22 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
   switch (pattern) {
     case Pattern::Raster: {
       walk_to(script, {low.x(), low.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
-      bool forward = true;
+      constexpr double kPress = 1.0;    // how far the careless hand presses into the part
+      constexpr double kSample = 0.2;   // the pass's points, mm apart
       for (double level = high.z() - 1.0; level >= low.z() - 1e-9; level -= 1.0) {
-        const double pressed = level - 1.0;  // pushed 1 mm down: the stencil or the floor stops it
+        bool forward = true;
         for (double x = low.x(); x <= high.x() + 1e-9; x += 1.0) {
-          walk_to(script, {x, forward ? low.y() : high.y(), pressed}, speed_mm_per_s, scale);
-          walk_to(script, {x, forward ? high.y() : low.y(), pressed}, speed_mm_per_s, scale);
+          const int samples = static_cast<int>(std::ceil((high.y() - low.y()) / kSample));
+          for (int i = 0; i <= samples; ++i) {
+            const double f = static_cast<double>(i) / samples;
+            const double y = forward ? low.y() + f * (high.y() - low.y()) : high.y() - f * (high.y() - low.y());
+            walk_to(script, {x, y, std::max(level, touch_tip(x, y) - kPress)}, speed_mm_per_s, scale);
+          }
           forward = !forward;
         }
-        // Back to the start corner over the top of what is left, for the next level.
+        // Back to the start corner over the top of everything, for the next level.
         walk_to(script, {high.x(), forward ? low.y() : high.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
         walk_to(script, {low.x(), low.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
-        forward = true;
       }
       break;
     }

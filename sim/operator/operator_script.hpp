@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <random>
 #include <string>
 #include <vector>
@@ -34,14 +35,17 @@ void walk_to(OperatorScript& script, const Eigen::Vector3d& to_world_mm, double 
 
 enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
 
-// The patterns over the stock (world mm), starting and ending at `home`:
-// raster: levels 1 mm apart from the stock's top down to the floor, passes along y 1 mm apart in x,
-//   each pressed 1 mm below its level, so the stencil holds the tool on the part where it meets it;
+// The patterns over the stock (world mm), starting and ending at `home`. `touch_tip(x, y)` is the
+// lowest the tool's tip can be over (x, y) without entering the part (the floor where it is clear):
+// raster: levels 1 mm apart from the stock's top down to the floor, passes along y 1 mm apart in x;
+//   where a pass meets the part it rides over it 1 mm too deep (a careless operator), so the
+//   stencil holds the tool on the part;
 // plunge: straight down to the floor at points 2 mm apart, through the part where it is there;
 // thinwall: fast sweeps straight across the stock at several heights, through whatever is there;
 // random: a random walk over and into the stock (seeded).
 [[nodiscard]] OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
-                                          double speed_mm_per_s, double device_mm_per_world_mm, std::uint64_t seed);
+                                          double speed_mm_per_s, double device_mm_per_world_mm, std::uint64_t seed,
+                                          const std::function<double(double, double)>& touch_tip);
 
 // A script from CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] (device space, times increasing). On bad
 // input returns false with `error` naming the line and what was expected.
