@@ -1,9 +1,10 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt fuzz bench clean help
+.PHONY: all deps build test test-asan test-debug rt fuzz bench demo clean help
 
 all: build
 
 help:
+	@echo "make demo       install dependencies, build, and run the host simulation on the baked-in hex prism (raster job)"
 	@echo "make test       install dependencies, configure, build and run every test (release preset)"
 	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
 	@echo "make test-debug the same without optimisation (build/debug)"
@@ -25,6 +26,12 @@ test: build
 
 bench: build
 	build/bin/stencil-bench
+
+# The main job: the host simulation on the baked-in sample part, a raster job until every reachable
+# triangle is touched; the report and its picture land in build/demo/.
+demo: build
+	mkdir -p build/demo
+	build/bin/stencil-sim --fast --pattern raster --until-complete --report build/demo/report.json
 
 test-asan: deps
 	cmake --preset asan

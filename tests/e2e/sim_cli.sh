@@ -1,0 +1,165 @@
+#!/usr/bin/env bash
+# End-to-end cases for stencil-sim (fast mode), one function case_NAME per ctest e2e.sim_NAME.
+#
+# usage: sim_cli.sh CASE STENCIL_SIM WORK_ROOT
+# Each case runs in a fresh directory under WORK_ROOT, removed when it passes and kept, with its path
+# printed, when it fails. Exit 0 pass, 1 fail. Only bash, coreutils, grep, sed and awk.
+set -uo pipefail
+
+if [ "$#" -ne 3 ]; then
+  echo "usage: $0 CASE STENCIL_SIM WORK_ROOT" >&2
+  exit 2
+fi
+case_name=$1 sim=$2 work_root=$3
+
+failures=0
+status=0
+
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+
+run_sim() {
+  echo "\$ stencil-sim $*"
+  "$sim" "$@" >stdout.txt 2>stderr.txt
+  status=$?
+  sed 's/^/  stdout: /' stdout.txt
+  sed 's/^/  stderr: /' stderr.txt
+  echo "  exit status $status"
+}
+
+expect_status() {
+  [ "$status" -eq "$1" ] || fail "exit status $status; expected $1"
+}
+
+expect_stderr() {
+  grep -Eq -- "$1" stderr.txt || fail "stderr does not say $2 (expected /$1/)"
+}
+
+# json_number FILE KEY: the first number after "KEY": in the report (nested keys are unique here).
+json_number() {
+  grep -E "\"$2\": " "$1" | head -n 1 | sed -E 's/.*": ([-0-9.eE+]+|null).*/\1/'
+}
+
+# at_most VALUE LIMIT WHAT
+at_most() {
+  awk -v v="$1" -v l="$2" 'BEGIN { exit !(v != "null" && v + 0 <= l + 0) }' || fail "$3 is $1; expected at most $2"
+}
+
+no_gouge() {
+  at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
+  grep -q '"safe_state": null' report.json || fail "the run ended in a safe state: $(grep safe_state report.json)"
+}
+
+# A corner of the hex prism's stock, raster until done: no gouge, and the stock this tool can
+# reach is cut away.
+case_raster_corner() {
+  run_sim --fast --pattern raster --until-complete --stock 15,3.6,0,25,12.5,7 --report report.json
+  expect_status 0
+  no_gouge
+  at_most "$(json_number report.json fraction)" 0.01 "the unmachined fraction"
+  [ -s report.svg ] || fail "no picture was written beside the report"
+  grep -q '<svg' report.svg || fail "report.svg is not an SVG picture"
+}
+
+case_plunge() {
+  run_sim --fast --pattern plunge --duration 150 --report report.json
+  expect_status 0
+  no_gouge
+}
+
+case_thinwall() {
+  run_sim --fast --pattern thinwall --duration 150 --report report.json
+  expect_status 0
+  no_gouge
+}
+
+case_random() {
+  run_sim --fast --pattern random --seed 7 --duration 150 --report report.json
+  expect_status 0
+  no_gouge
+}
+
+# The same inputs give the same report, apart from the wall-clock fields.
+case_same_report_twice() {
+  strip_wall_clock() {
+    awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+  }
+  run_sim --fast --pattern random --seed 3 --duration 60 --report first.json
+  expect_status 0
+  run_sim --fast --pattern random --seed 3 --duration 60 --report second.json
+  expect_status 0
+  if ! diff <(strip_wall_clock first.json) <(strip_wall_clock second.json); then
+    fail "two runs of the same job gave different reports"
+  fi
+}
+
+case_trace_is_written() {
+  run_sim --fast --pattern plunge --duration 30 --trace trace.csv --report report.json
+  expect_status 0
+  head -n 1 trace.csv | grep -qx 't_s,x_mm,y_mm,z_mm' || fail "trace.csv has no header t_s,x_mm,y_mm,z_mm"
+  [ "$(wc -l <trace.csv)" -gt 10 ] || fail "trace.csv has fewer than 10 corners"
+  awk -F, 'NR > 1 && (NF != 4 || $1 + 0 < prev) { bad = 1 } NR > 1 { prev = $1 + 0 } END { exit bad }' trace.csv ||
+    fail "trace.csv rows are not t_s,x_mm,y_mm,z_mm with t_s increasing"
+}
+
+case_refuses_real_time_mode_not_built() {
+  run_sim --pattern raster
+  expect_status 2
+  expect_stderr "pass --fast" "that only --fast is built"
+}
+
+case_refuses_a_bad_operator_csv() {
+  printf 't_s,x_mm,y_mm,z_mm\n0,250,125,200\n0.5,250,abc,200\n' >operator.csv
+  run_sim --fast --operator operator.csv --report report.json
+  expect_status 2
+  expect_stderr "operator.csv: line 3: field 3 'abc' is not a finite number" "the file, line and field"
+  [ ! -e report.json ] || fail "a report was written for bad input"
+}
+
+case_refuses_times_that_do_not_increase() {
+  printf '0,250,125,200\n1,250,125,190\n1,250,125,180\n' >operator.csv
+  run_sim --fast --operator operator.csv
+  expect_status 2
+  expect_stderr "operator.csv: line 3: t_s 1.0+ does not increase" "the line whose time goes back"
+}
+
+case_refuses_a_bad_stock() {
+  run_sim --fast --stock 1,2,3
+  expect_status 2
+  expect_stderr "--stock 1,2,3: 3 numbers; expected X0,Y0,Z0,X1,Y1,Z1" "the option and what it expects"
+  run_sim --fast --stock 10,10,0,5,20,7
+  expect_status 2
+  expect_stderr "--stock 10,10,0,5,20,7: axis x must have 0 <= low < high" "the axis at fault"
+}
+
+case_refuses_a_file_that_is_not_a_table() {
+  printf 'not a table\n' >junk.stbl
+  run_sim --fast --tables junk.stbl
+  expect_status 2
+  expect_stderr "junk.stbl: not a valid table" "the file and that it is not a table"
+  run_sim --fast --tables missing.stbl
+  expect_status 2
+  expect_stderr "missing.stbl: cannot be read" "the missing file"
+}
+
+case_refuses_an_unknown_pattern() {
+  run_sim --fast --pattern spiral
+  expect_status 2
+  expect_stderr "spiral" "the pattern it does not know"
+}
+
+if ! declare -F "case_$case_name" >/dev/null; then
+  echo "sim_cli.sh: no case '$case_name'" >&2
+  exit 2
+fi
+work="$work_root/sim_$case_name"
+rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+"case_$case_name"
+if [ "$failures" -gt 0 ]; then
+  echo "$failures failure(s); the case's files are in $work" >&2
+  exit 1
+fi
+cd / && rm -rf "$work"
+exit 0
