@@ -20,7 +20,7 @@ double sweep_step_mm(const tables::PartTables& part) { return 0.5 * part.header.
 
 SweepResult check_sweep(const tables::PartTables& part, const Eigen::Vector3d& from_mm, const Eigen::Vector3d& to_mm,
                         double step_mm, int max_steps) {
-  SweepResult result{SweepStatus::Legal, from_mm, 0};
+  SweepResult result{SweepStatus::Legal, from_mm, to_mm, 0};
   if (!from_mm.allFinite() || !to_mm.allFinite() || !(step_mm > 0.0) || max_steps < 1) {
     result.status = SweepStatus::Fault;
     return result;
@@ -44,6 +44,7 @@ SweepResult check_sweep(const tables::PartTables& part, const Eigen::Vector3d& f
         break;
       case Legality::Illegal:
         result.status = SweepStatus::Illegal;
+        result.blocked_mm = at;
         return result;
       case Legality::Fault:
         result.status = SweepStatus::Fault;

@@ -29,6 +29,7 @@ enum class SweepStatus : std::uint8_t {
 struct SweepResult {
   SweepStatus status;
   Eigen::Vector3d reached_mm;  // the last legal sub-step (from itself when none was)
+  Eigen::Vector3d blocked_mm;  // Illegal: the first sub-step that was not legal; else to_mm
   int steps;                   // sub-steps checked
 };
 

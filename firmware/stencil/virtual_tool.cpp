@@ -48,29 +48,17 @@ Eigen::Vector3d VirtualTool::clamp_to_box(const Eigen::Vector3d& tip) const {
   return tip.cwiseMax(Eigen::Vector3d::Zero()).cwiseMin(box_high_);
 }
 
-RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
-                                    const ContactParameters& parameters) {
-  RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0, false};
-  if (!desired_tip_mm.allFinite()) {
-    result.status = RemediationStatus::Fault;
-    return result;
-  }
-  // The floor and the workspace walls are planes of the stencil: project onto them analytically.
-  Eigen::Vector3d candidate = clamp_to_box(desired_tip_mm);
-  const bool clamped = candidate != desired_tip_mm;
-  bool found = false;
+VirtualTool::Slip VirtualTool::slip_out(Eigen::Vector3d& candidate, const ContactResult* contact_at_candidate,
+                                        const ContactParameters& parameters, int& iterations) const {
   for (int iteration = 0; iteration <= kMaxSlipIterations; ++iteration) {
-    // The first candidate is the desired pose itself unless a wall of the box moved it.
-    const ContactResult contact = (iteration == 0 && !clamped)
-                                      ? contact_at_desired
+    const ContactResult contact = (iteration == 0 && contact_at_candidate != nullptr)
+                                      ? *contact_at_candidate
                                       : query_contacts(part_, {candidate, Eigen::Vector3d::UnitZ()}, parameters);
     if (contact.status != QueryStatus::Ok) {
-      result.status = RemediationStatus::Fault;
-      return result;
+      return Slip::Fault;
     }
     if (contact.penetrating_points == 0) {
-      found = true;
-      break;
+      return Slip::Legal;
     }
     if (iteration == kMaxSlipIterations) {
       break;
@@ -83,13 +71,54 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
     const Eigen::Vector3d reaction = contact.force_n / force;
     const double slip = slip_length_mm(part_, candidate, contact, reaction);
     candidate = clamp_to_box(candidate + slip * reaction);
-    result.slip_iterations = iteration + 1;
+    iterations = iteration + 1;
   }
-  if (!found) {
-    result.status = RemediationStatus::Stuck;
+  return Slip::NotFound;
+}
+
+RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
+                                    const ContactParameters& parameters) {
+  RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0, false};
+  if (!desired_tip_mm.allFinite()) {
+    result.status = RemediationStatus::Fault;
     return result;
   }
-  const SweepResult sweep = check_sweep(part_, tip_, candidate, sweep_step_, kMaxSweepSteps);
+  // The floor and the workspace walls are planes of the stencil: project onto them analytically.
+  Eigen::Vector3d candidate = clamp_to_box(desired_tip_mm);
+  const bool clamped = candidate != desired_tip_mm;
+  // The first candidate is the desired pose itself unless a wall of the box moved it.
+  switch (slip_out(candidate, clamped ? nullptr : &contact_at_desired, parameters, result.slip_iterations)) {
+    case Slip::Fault:
+      result.status = RemediationStatus::Fault;
+      return result;
+    case Slip::NotFound:
+      result.status = RemediationStatus::Stuck;
+      return result;
+    case Slip::Legal:
+      break;
+  }
+  SweepResult sweep = check_sweep(part_, tip_, candidate, sweep_step_, kMaxSweepSteps);
+  bool slid = false;
+  if (sweep.status == SweepStatus::Illegal && sweep.reached_mm == tip_) {
+    // Blocked right here: the straight way to a legal pose cuts a corner of the part. Slide along
+    // the part instead: the first blocked sub-step slipped out of it, if the short sweep there is
+    // legal. Each cycle gains a sub-step round the obstacle; none goes through it.
+    Eigen::Vector3d around = sweep.blocked_mm;
+    int around_slips = 0;
+    const Slip slip = slip_out(around, nullptr, parameters, around_slips);
+    if (slip == Slip::Fault) {
+      result.status = RemediationStatus::Fault;
+      return result;
+    }
+    if (slip == Slip::Legal) {
+      const SweepResult short_sweep = check_sweep(part_, tip_, around, sweep_step_, kMaxSweepSteps);
+      if (short_sweep.status == SweepStatus::Legal || short_sweep.status == SweepStatus::Limited) {
+        sweep = short_sweep;
+        result.slip_iterations += around_slips;
+        slid = true;
+      }
+    }
+  }
   // Every point between the tip and `reached` was checked, so a shorter move along it is legal too.
   const Eigen::Vector3d reached =
       shorten_move(tip_, sweep.reached_mm, max_axis_move_, max_total_move_, result.speed_limited);
@@ -105,11 +134,12 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
       break;
     case SweepStatus::Limited:
       tip_ = reached;
-      result.status = RemediationStatus::SweepLimited;
+      result.status = slid ? RemediationStatus::Slipped : RemediationStatus::SweepLimited;
       break;
     case SweepStatus::Legal:
       tip_ = reached;
-      result.status = (result.slip_iterations > 0 || clamped) ? RemediationStatus::Slipped : RemediationStatus::Followed;
+      result.status =
+          (result.slip_iterations > 0 || clamped || slid) ? RemediationStatus::Slipped : RemediationStatus::Followed;
       break;
   }
   result.tip_mm = tip_;

@@ -42,8 +42,9 @@ class VirtualTool {
   // `home_tip_mm` must itself be legal (the machine's homed pose, above the part).
   VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm);
 
-  // One cycle: moves towards `desired_tip_mm` as far as legality allows. Allocation-free, bounded
-  // by kMaxSlipIterations queries and kMaxSweepSteps legality checks per sweep. The cycle already
+  // One cycle: moves towards `desired_tip_mm` as far as legality allows; where the straight way is
+  // blocked right at the tip, it slides round the obstacle by one slipped sub-step. Allocation-free,
+  // bounded by 2 x kMaxSlipIterations queries and 2 x kMaxSweepSteps legality checks. The cycle already
   // queries the desired pose for the haptic force: pass that result in, so it is not done twice.
   RemediationResult step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
                          const ContactParameters& parameters);
@@ -64,6 +65,11 @@ class VirtualTool {
 
  private:
   [[nodiscard]] Eigen::Vector3d clamp_to_box(const Eigen::Vector3d& tip) const;
+  enum class Slip : std::uint8_t { Legal, NotFound, Fault };
+  // Moves `candidate` out along the reaction until it is legal, at most kMaxSlipIterations times
+  // (the first query's result may be given); `iterations` counts the slips made.
+  [[nodiscard]] Slip slip_out(Eigen::Vector3d& candidate, const ContactResult* contact_at_candidate,
+                              const ContactParameters& parameters, int& iterations) const;
 
   const tables::PartTables& part_;
   Eigen::Vector3d tip_;

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "firmware/stencil/haptic_force.hpp"
+#include "firmware/stencil/sweep.hpp"
 #include "firmware/stencil/virtual_tool.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
@@ -132,6 +133,33 @@ TEST(VirtualTool, PushedIntoAConcaveCornerItSlipsOutToBothFacesWithinTwoSlips) {
   DOUBLES_EQUAL(25.0, tool.tip_mm().x(), 1e-6);
   DOUBLES_EQUAL(11.0, tool.tip_mm().y(), 0.01);
   DOUBLES_EQUAL(3.0, tool.tip_mm().z(), 0.01);
+}
+
+TEST(VirtualTool, WhereTheStraightWayCutsACornerItSlidesRoundTheCornerInsteadOfSticking) {
+  // The hex prism's vertex at (33, 12.5), its walls receding on both sides. The tool rests against
+  // the vertex from the +x side, low enough for its side to meet it; the hand goes round to a legal
+  // point beyond, so the straight line from the tool cuts through the vertex.
+  const Loaded loaded(tablegen::hexagonal_prism(8.0, 6.0, 25.0, 12.5));
+  const double radius = loaded.part.tool.envelope.cutter_radius_mm;
+  VirtualTool tool(loaded.part, {33.0 + radius + 0.05, 13.2, 2.0});
+  CHECK(check_legal(loaded.part, tool.pose()) == Legality::Legal);
+  const Eigen::Vector3d beyond(33.0 + radius - 0.2, 10.0, 2.0);  // legal: the wall has receded there
+  CHECK(check_tip_legal(loaded.part, beyond) == Legality::Legal);
+  CHECK(check_sweep(loaded.part, tool.tip_mm(), beyond, tool.sweep_step_mm(), kMaxSweepSteps).status ==
+        SweepStatus::Illegal);
+  int stuck = 0;
+  for (int i = 0; i < 400 && (tool.tip_mm() - beyond).norm() > 1e-9; ++i) {
+    const Eigen::Vector3d before = tool.tip_mm();
+    const RemediationResult result = tool.step(beyond, ContactParameters{});
+    stuck += result.status == RemediationStatus::Stuck ? 1 : 0;
+    CHECK(check_legal(loaded.part, tool.pose()) == Legality::Legal);
+    CHECK(test::ball_end_gouge_mm(loaded.part, tool.tip_mm()) <= loaded.part.header.gouge_bound_mm + 1e-5);
+    // Every move it made was itself a checked straight sweep.
+    CHECK(check_sweep(loaded.part, before, tool.tip_mm(), tool.sweep_step_mm(), kMaxSweepSteps).status !=
+          SweepStatus::Illegal);
+  }
+  LONGS_EQUAL(0, stuck);
+  CHECK((tool.tip_mm() - beyond).norm() < 1e-9);  // it got round
 }
 
 TEST(VirtualTool, WithASpeedLimitItMovesNoFasterThanTheMillAndStaysLegal) {
