@@ -40,14 +40,8 @@ bool parse_stock(const std::string& text, const tables::PartTables& part, sim::S
   std::stringstream fields(text);
   std::string field;
   while (std::getline(fields, field, ',')) {
-    std::size_t used = 0;
     double value = 0.0;
-    try {
-      value = std::stod(field, &used);
-    } catch (...) {
-      used = 0;
-    }
-    if (used == 0 || used != field.size() || !std::isfinite(value)) {
+    if (!sim::parse_finite_field(field, value)) {
       error = "--stock " + text + ": '" + field + "' is not a number; expected X0,Y0,Z0,X1,Y1,Z1 in mm";
       return false;
     }

@@ -123,6 +123,19 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
   return script;
 }
 
+bool parse_finite_field(const std::string& field, double& value) {
+  std::size_t used = 0;
+  try {
+    value = std::stod(field, &used);
+  } catch (...) {
+    return false;  // not a number at all, or out of double's range
+  }
+  while (used < field.size() && (field[used] == ' ' || field[used] == '\r')) {
+    ++used;
+  }
+  return used != 0 && used == field.size() && std::isfinite(value);
+}
+
 bool read_operator_csv(const std::string& path, OperatorScript& script, std::string& error) {
   std::ifstream in(path);
   if (!in) {
@@ -140,17 +153,8 @@ bool read_operator_csv(const std::string& path, OperatorScript& script, std::str
     std::stringstream fields(line);
     std::string field;
     while (std::getline(fields, field, ',')) {
-      std::size_t used = 0;
       double value = 0.0;
-      try {
-        value = std::stod(field, &used);
-      } catch (...) {
-        used = 0;
-      }
-      while (used < field.size() && (field[used] == ' ' || field[used] == '\r')) {
-        ++used;
-      }
-      if (used == 0 || used != field.size() || !std::isfinite(value)) {
+      if (!parse_finite_field(field, value)) {
         error = path + ": line " + std::to_string(number) + ": field " + std::to_string(values.size() + 1) + " '" + field +
                 "' is not a finite number";
         return false;

@@ -47,6 +47,10 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
                                           double speed_mm_per_s, double device_mm_per_world_mm, std::uint64_t seed,
                                           const std::function<double(double, double)>& touch_tip);
 
+// One comma-separated field as a finite number: all of it (trailing blanks and a carriage return
+// aside), or false. For the CSV reader and the programs' number lists alike.
+[[nodiscard]] bool parse_finite_field(const std::string& field, double& value);
+
 // A script from CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] (device space, times increasing). On bad
 // input returns false with `error` naming the line and what was expected.
 [[nodiscard]] bool read_operator_csv(const std::string& path, OperatorScript& script, std::string& error);
