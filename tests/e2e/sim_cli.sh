@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# End-to-end cases for stencil-sim (fast mode), one function case_NAME per ctest e2e.sim_NAME.
+# End-to-end cases for stencil-sim (fast mode) and stencil-rig's start-up checks, one function
+# case_NAME per ctest e2e.sim_NAME.
 #
 # usage: sim_cli.sh CASE STENCIL_SIM WORK_ROOT
 # Each case runs in a fresh directory under WORK_ROOT, removed when it passes and kept, with its path
@@ -11,6 +12,7 @@ if [ "$#" -ne 3 ]; then
   exit 2
 fi
 case_name=$1 sim=$2 work_root=$3
+rig="$(dirname "$sim")/stencil-rig"
 
 failures=0
 status=0
@@ -149,6 +151,40 @@ case_refuses_an_unknown_pattern() {
   run_sim --fast --pattern spiral
   expect_status 2
   expect_stderr "spiral" "the pattern it does not know"
+}
+
+run_rig() {
+  echo "\$ stencil-rig $*"
+  "$rig" "$@" >stdout.txt 2>stderr.txt
+  status=$?
+  sed 's/^/  stdout: /' stdout.txt
+  sed 's/^/  stderr: /' stderr.txt
+  echo "  exit status $status"
+}
+
+# The rig program on a machine without the rig: it checks what it can and says what is missing.
+case_rig_without_the_hardware_fails_cleanly() {
+  mkdir -p parts && "$(dirname "$sim")/stencil-sample-parts" parts >/dev/null || fail "stencil-sample-parts failed"
+  "$(dirname "$sim")/stencil-tablegen" parts/hex_prism.stl -o part.stbl --tool ball:d=3 --quiet 2>/dev/null ||
+    fail "stencil-tablegen failed"
+  : >not_a_tty
+  run_rig --tables part.stbl --serial not_a_tty --haptic pio:/dev/uio-missing
+  expect_status 3
+  expect_stderr "the mill's CY545: .*not_a_tty: not a serial port" "that the serial port is not a tty"
+  grep -q "real-time readiness:" stdout.txt || fail "the real-time readiness was not printed"
+  grep -q "PREEMPT_RT kernel:" stdout.txt || fail "PREEMPT_RT was not reported"
+  run_rig --tables part.stbl --serial missing-port --haptic can:can0
+  expect_status 3
+  expect_stderr "missing-port" "the missing serial port by name"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic usb:0
+  expect_status 2
+  expect_stderr "--haptic usb:0: expected pio:/dev/uioN or can:IFACE" "the option and what it expects"
+  run_rig --tables missing.stbl --serial /dev/ttyS0 --haptic can:can0
+  expect_status 2
+  expect_stderr "missing.stbl: cannot be read" "the missing table"
+  run_rig --serial /dev/ttyS0 --haptic can:can0
+  expect_status 2
+  expect_stderr "--tables" "the missing option"
 }
 
 if ! declare -F "case_$case_name" >/dev/null; then
