@@ -12,6 +12,8 @@
 #include <cmath>
 #include <memory>
 
+#include <sys/socket.h>
+
 #include "firmware/control/controller.hpp"
 #include "firmware/control/loop_statistics.hpp"
 #include "firmware/control/machine_side.hpp"
@@ -19,7 +21,14 @@
 #include "hal/cy545/serial_port.hpp"
 #include "sim/cy545/fake_cy545.hpp"
 #include "sim/cy545/fake_cy545_clock.hpp"
+#include "hal/pio_shared_memory/pio_haptic_device.hpp"
+#include "hal/pio_shared_memory/shared_window_mapping.hpp"
+#include "hal/socketcan/fd_can_channel.hpp"
+#include "hal/socketcan/socketcan_haptic_device.hpp"
+#include "sim/haptic_device/can_device_link.hpp"
 #include "sim/haptic_device/direct_haptic_device.hpp"
+#include "sim/haptic_device/pio_device_link.hpp"
+#include "sim/haptic_device/simulated_haptic_device.hpp"
 #include "sim/mill/machined_part.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
@@ -51,6 +60,77 @@ double reachable_coverage(const tables::PartTables& part, const engine::Triangle
   }
   return static_cast<double>(covered) / static_cast<double>(part.header.reachable_triangle_count);
 }
+
+// The simulated device as the cycle sees it, by the chosen transport. The hand's handle is where the
+// device's samples say; `rendered()` is what the device's motors drive now.
+class SimulatedDeviceWiring {
+ public:
+  SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand, std::string& error)
+      : transport_(transport), direct_(hal::kCornerOriginHapticRange) {
+    const auto pose = [&hand](std::uint32_t, hal::MonotonicNs) {
+      return stencil::sim::SimulatedPose{{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {0.0, 0.0}};
+    };
+    if (transport == HapticTransport::Pio) {
+      window_ = hal::pio_shared_memory::SharedWindowMapping::create_memfd("stencil-sim-pio", error);
+      if (window_ == nullptr) {
+        return;
+      }
+      device_link_ = std::make_unique<stencil::sim::PioDeviceLink>(window_->window());
+      pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), hal::kCornerOriginHapticRange);
+      host_ = pio_host_.get();
+    } else if (transport == HapticTransport::Can) {
+      int fds[2] = {-1, -1};
+      if (::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC | SOCK_NONBLOCK, 0, fds) != 0) {
+        error = "socketpair for the simulated CAN bus failed";
+        return;
+      }
+      host_channel_ = std::make_unique<hal::socketcan::FdCanChannel>(fds[0]);
+      device_channel_ = std::make_unique<hal::socketcan::FdCanChannel>(fds[1]);
+      device_link_ = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
+      can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), hal::kCornerOriginHapticRange);
+      host_ = can_host_.get();
+    }
+    if (device_link_ != nullptr) {
+      simulated_ = std::make_unique<stencil::sim::SimulatedHapticDevice>(*device_link_, pose);
+    }
+  }
+
+  [[nodiscard]] bool ready() const { return transport_ == HapticTransport::Direct || simulated_ != nullptr; }
+  [[nodiscard]] hal::HapticDevice& host() { return transport_ == HapticTransport::Direct ? direct_ : *host_; }
+
+  // The device's millisecond: a new sample of the handle, the host's newest command taken.
+  void device_cycle(const stencil::sim::OperatorHand& hand, const Eigen::Vector2d& angles, hal::MonotonicNs now_ns) {
+    if (transport_ == HapticTransport::Direct) {
+      ++counter_;
+      direct_.publish({{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {angles.x(), angles.y()}, counter_,
+                       hal::haptic_status::kForceApplied, counter_});
+      return;
+    }
+    simulated_->step(now_ns);
+  }
+
+  [[nodiscard]] Eigen::Vector3d rendered_force() const {
+    if (transport_ == HapticTransport::Direct) {
+      const hal::HapticCommand& c = direct_.rendered();
+      return {c.force_n[0], c.force_n[1], c.force_n[2]};
+    }
+    const stencil::sim::DeviceOutput output = simulated_->output();
+    return {output.force_n[0], output.force_n[1], output.force_n[2]};
+  }
+
+ private:
+  HapticTransport transport_;
+  stencil::sim::DirectHapticDevice direct_;
+  std::unique_ptr<hal::pio_shared_memory::SharedWindowMapping> window_;
+  std::unique_ptr<hal::socketcan::FdCanChannel> host_channel_, device_channel_;
+  std::unique_ptr<stencil::sim::DeviceSideLink> device_link_;
+  // The backends' destructors are theirs (HapticDevice's is protected): one owner each.
+  std::unique_ptr<hal::pio_shared_memory::PioHapticDevice> pio_host_;
+  std::unique_ptr<hal::socketcan::SocketCanHapticDevice> can_host_;
+  hal::HapticDevice* host_ = nullptr;
+  std::unique_ptr<stencil::sim::SimulatedHapticDevice> simulated_;
+  std::uint32_t counter_ = 0;
+};
 
 }  // namespace
 
@@ -111,7 +191,15 @@ SimResult run_fast(const SimJob& job) {
   auto handoffs = std::make_unique<control::MachineHandoffRing>();
   auto telemetry = std::make_unique<control::TelemetryRing>();
   auto journal = std::make_unique<control::JournalRing>();
-  stencil::sim::DirectHapticDevice device{hal::kCornerOriginHapticRange};
+  // The operator's hand, where the script starts, and the device it holds.
+  stencil::sim::OperatorHand hand;
+  hand.handle_mm = job.script.position_at(0.0);
+  std::string wiring_error;
+  SimulatedDeviceWiring device{job.transport, hand, wiring_error};
+  if (!device.ready()) {
+    result.error = "the simulated device's link: " + wiring_error;
+    return result;
+  }
 
   control::ControllerConfig config;
   config.frames = frames;
@@ -122,7 +210,7 @@ SimResult run_fast(const SimJob& job) {
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   auto controller = std::make_unique<control::Controller>(
-      part, device, control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
+      part, device.host(), control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
   if (!controller->ready()) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
@@ -137,9 +225,6 @@ SimResult run_fast(const SimJob& job) {
   machined.arm({mill.axis_position_steps(stencil::sim::Axis::x), mill.axis_position_steps(stencil::sim::Axis::y),
                 mill.axis_position_steps(stencil::sim::Axis::z)});
 
-  // The operator's hand, where the script starts.
-  stencil::sim::OperatorHand hand;
-  hand.handle_mm = job.script.position_at(0.0);
   const hal::MonotonicNs start_ns = (machine_clock.now_ns() / kPeriodNs + 1) * kPeriodNs;
   hal::MonotonicNs cycle_ns = start_ns;
   hal::MonotonicNs next_update_ns = start_ns;
@@ -147,7 +232,6 @@ SimResult run_fast(const SimJob& job) {
   // After the script, the mill is given up to this long to catch up with the virtual tool.
   constexpr double kCatchUpS = 30.0;
   control::MicrosecondHistogram compute;
-  std::uint32_t sample_counter = 0;
   double next_progress_s = 10.0;
   bool stop_after_update = false;
   for (;;) {
@@ -162,12 +246,8 @@ SimResult run_fast(const SimJob& job) {
       continue;
     }
     const double t_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
-    const hal::HapticCommand& rendered = device.rendered();
-    hand.step(job.script.position_at(t_s),
-              Eigen::Vector3d(rendered.force_n[0], rendered.force_n[1], rendered.force_n[2]));
-    const Eigen::Vector2d angles = job.script.angles_at(t_s);
-    device.publish({{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {angles.x(), angles.y()},
-                    ++sample_counter, hal::haptic_status::kForceApplied, sample_counter});
+    hand.step(job.script.position_at(t_s), device.rendered_force());
+    device.device_cycle(hand, job.script.angles_at(t_s), cycle_ns);
     const auto wall_before = std::chrono::steady_clock::now();
     const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());

@@ -30,7 +30,12 @@ inline constexpr double kHomeWorldMm[3] = {50.0, 25.0, 25.0};
 inline constexpr double kVirtualToolSpeedMmPerS = 1.0;
 inline constexpr double kOperatorSpeedMmPerS = 0.8;
 
+// How the cycle reaches the simulated device: in process, or through the real backends' code over a
+// memfd window (the PIO card's layout) or a socketpair carrying CAN frames.
+enum class HapticTransport : std::uint8_t { Direct, Pio, Can };
+
 struct SimJob {
+  HapticTransport transport = HapticTransport::Direct;
   const tables::PartTables* part = nullptr;
   stencil::sim::StockBox stock{};
   stencil::sim::OperatorScript script;

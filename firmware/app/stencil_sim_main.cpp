@@ -96,7 +96,9 @@ int main(int argc, char** argv) {
                "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
   app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the part's box grown by 2 mm)");
   app.add_option("--trace", trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
-  app.add_option("--haptic-transport", transport, "how the cycle reaches the simulated device (only direct is built so far)")
+  app.add_option("--haptic-transport", transport,
+                 "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
+                 "SocketCAN code over a memfd or a socketpair")
       ->check(CLI::IsMember({"direct", "pio", "can"}))
       ->capture_default_str();
   try {
@@ -106,9 +108,6 @@ int main(int argc, char** argv) {
   }
   if (!fast) {
     return bad_input("real-time mode (--speed) is not built yet: pass --fast");
-  }
-  if (transport != "direct") {
-    return bad_input("--haptic-transport " + transport + " is not built yet: use direct");
   }
 
   // The part: a table file read into memory, or the baked-in section used in place.
@@ -153,6 +152,9 @@ int main(int argc, char** argv) {
     job.script = sim::make_pattern(pattern, job.stock, home, board::sim::kOperatorSpeedMmPerS,
                                    board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock));
   }
+  job.transport = transport == "pio"   ? board::sim::HapticTransport::Pio
+                  : transport == "can" ? board::sim::HapticTransport::Can
+                                       : board::sim::HapticTransport::Direct;
   job.duration_s = duration_s;
   job.until_complete = until_complete;
   std::FILE* trace = nullptr;
