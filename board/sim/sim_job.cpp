@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <thread>
 
 #include <sys/socket.h>
 
@@ -19,8 +20,10 @@
 #include "firmware/control/machine_side.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/cy545/serial_port.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"
 #include "sim/cy545/fake_cy545_clock.hpp"
+#include "sim/cy545/fake_cy545_runner.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/shared_window_mapping.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
@@ -160,7 +163,54 @@ std::function<double(double, double)> touch_tip_of(const tables::PartTables& par
   };
 }
 
-SimResult run_fast(const SimJob& job) {
+namespace {
+
+// The result of a job from its parts, once they have stopped.
+SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
+                        const control::MachineSide& machine, const stencil::sim::MachinedPart& machined,
+                        const hal::cy545::Cy545Link& link, const control::MicrosecondHistogram& compute,
+                        double simulated_s, std::chrono::steady_clock::time_point wall_start,
+                        stencil::sim::SimulatedMill& mill, bool realtime) {
+  const stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
+  result.cycles = controller.statistics().cycles;
+  result.overruns = controller.statistics().overruns;
+  // On virtual time every cycle starts on its deadline: no wake-up latency to speak of.
+  result.wakeup_latency_us = realtime ? quantiles_of(controller.statistics().wakeup_latency) : Quantiles{0.0, 0.0, 0.0, 0.0};
+  result.compute_us = quantiles_of(compute);
+  result.simulated_s = simulated_s;
+  result.gouge_max_depth_mm = machined.max_gouge_mm();
+  result.gouge_measured = machined.gouge_measured();
+  result.gouge_volume_mm3 = volumes.gouge_mm3;
+  result.removed_volume_mm3 = volumes.removed_mm3;
+  result.unmachined_volume_mm3 = volumes.unmachined_mm3;
+  result.reachable_volume_mm3 = volumes.reachable_mm3;
+  result.coverage_fraction = reachable_coverage(part, controller.touched());
+  result.max_force_n = controller.max_force_n();
+  result.max_offset_mm = controller.max_offset_mm();
+  result.machine_updates = machine.statistics().updates;
+  result.machine_take_ups = machine.statistics().take_ups;
+  result.machine_max_lag_mm = machine.statistics().max_lag_mm;
+  result.safe_state = controller.safe_reason();
+  if (machine.fault() != hal::MachineFault::None || machine.state() == control::MachineSideState::Stopped) {
+    result.machine_error = link.last_error();
+  }
+  const stencil::sim::StockZmap& stock = machined.stock();
+  result.columns = stock.columns();
+  result.rows = stock.rows();
+  result.cell_mm = stock.cell_mm();
+  for (int row = 0; row < stock.rows(); ++row) {
+    for (int column = 0; column < stock.columns(); ++column) {
+      result.stock_heights.push_back(stock.height(column, row));
+    }
+  }
+  result.part_heights = machined.part_heights();
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  mill.set_motion_observer(nullptr);
+  return result;
+}
+
+SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
+  const bool realtime = runner != nullptr;
   SimResult result;
   const tables::PartTables& part = *job.part;
   const auto wall_start = std::chrono::steady_clock::now();
@@ -168,10 +218,14 @@ SimResult run_fast(const SimJob& job) {
 
   // The far side of the serial cable: the mill, its fake CY545 on a pty, the clock they follow.
   stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
-  stencil::sim::cy545::FakeCy545 fake{mill, 0};
-  stencil::sim::cy545::FakeCy545Clock machine_clock{fake, 0, kBaud};
-  stencil::sim::MachinedPart machined{part, job.stock, frames,
-                                      [&fake] { return static_cast<double>(fake.chip().now_ns()) / 1e9; }};
+  const hal::MonotonicNs epoch_ns = realtime ? stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() : 0;
+  stencil::sim::cy545::FakeCy545 fake{mill, epoch_ns};
+  stencil::sim::cy545::FakeCy545Clock fast_clock{fake, 0, kBaud};
+  hal::posix_clock::MonotonicClock wall_clock;
+  hal::Clock& machine_clock = realtime ? static_cast<hal::Clock&>(wall_clock) : fast_clock;
+  stencil::sim::MachinedPart machined{part, job.stock, frames, [&fake, epoch_ns] {
+                                        return static_cast<double>(fake.chip().now_ns() - epoch_ns) / 1e9;
+                                      }};
   machined.set_trace(job.trace);
   mill.set_motion_observer(&machined);
 
@@ -206,7 +260,7 @@ SimResult run_fast(const SimJob& job) {
   config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
   config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
   config.home_tip_mm = frames.home_world_mm;
-  config.count_overruns = false;  // virtual time: lateness means nothing
+  config.count_overruns = realtime;  // on virtual time lateness means nothing
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   auto controller = std::make_unique<control::Controller>(
@@ -217,20 +271,108 @@ SimResult run_fast(const SimJob& job) {
   }
   const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
   auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, *handoffs, *machine_events);
+  // In real time the fake CY545 answers from a thread of its own; on virtual time it follows the
+  // machine side's clock.
+  std::unique_ptr<stencil::sim::cy545::FakeCy545Runner> fake_runner;
+  if (realtime) {
+    fake_runner = std::make_unique<stencil::sim::cy545::FakeCy545Runner>(fake);
+  }
   if (!machine->start(machine_clock.now_ns() + 120'000'000'000)) {
     result.error = std::string("the machine did not start: ") + link.last_error();
     return result;
   }
   result.started = true;
-  machined.arm({mill.axis_position_steps(stencil::sim::Axis::x), mill.axis_position_steps(stencil::sim::Axis::y),
-                mill.axis_position_steps(stencil::sim::Axis::z)});
+  const auto arm = [&] {
+    machined.arm({mill.axis_position_steps(stencil::sim::Axis::x), mill.axis_position_steps(stencil::sim::Axis::y),
+                  mill.axis_position_steps(stencil::sim::Axis::z)});
+  };
+  if (realtime) {
+    fake_runner->with_fake([&](stencil::sim::cy545::FakeCy545&) { arm(); });
+  } else {
+    arm();
+  }
 
-  const hal::MonotonicNs start_ns = (machine_clock.now_ns() / kPeriodNs + 1) * kPeriodNs;
-  hal::MonotonicNs cycle_ns = start_ns;
-  hal::MonotonicNs next_update_ns = start_ns;
   const double duration_s = job.duration_s > 0.0 ? job.duration_s : job.script.duration_s();
   // After the script, the mill is given up to this long to catch up with the virtual tool.
   constexpr double kCatchUpS = 30.0;
+  if (realtime) {
+    std::atomic<bool> stop{false};
+    std::atomic<bool> drained{false};
+    std::string runner_error;
+    hal::MonotonicNs start_ns = 0;
+    std::thread machine_thread([&] {
+      hal::MonotonicNs next = machine_clock.now_ns();
+      while (!stop.load()) {
+        machine_clock.sleep_until_ns(next);
+        machine->update(next + 2 * kUpdateNs);
+        fake_runner->with_fake([&](stencil::sim::cy545::FakeCy545&) { machined.flush(); });
+        drained.store(machine->path_left() <= 1 && machine->at_goal());
+        next = std::max(next + kUpdateNs, machine_clock.now_ns());
+      }
+    });
+    std::thread records_thread([&] {
+      while (!stop.load()) {
+        control::JournalRecord record{};
+        while (journal->pop(record)) {
+        }
+        control::Telemetry frame{};
+        while (telemetry->pop(frame)) {
+        }
+        if (job.interrupted != nullptr && job.interrupted->load()) {
+          static_cast<void>(commands->push({control::CommandKind::Stop}));
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      }
+    });
+    double next_progress_s = 10.0;
+    const bool ran = (*runner)(
+        kPeriodNs, stop,
+        [&](hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+          if (start_ns == 0) {
+            start_ns = deadline_ns;
+          }
+          const double t_s = static_cast<double>(now_ns - start_ns) / 1e9;
+          hand.step(job.script.position_at(t_s), device.rendered_force());
+          device.device_cycle(hand, job.script.angles_at(t_s), now_ns);
+          const control::CycleStatus status = controller->step(now_ns, deadline_ns);
+          controller->finish(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns(), deadline_ns + kPeriodNs);
+          if (status == control::CycleStatus::SafeState || controller->safe_reason() != control::SafeReason::None) {
+            return false;
+          }
+          if (controller->statistics().cycles % 1000 != 0) {
+            return true;
+          }
+          const double coverage = reachable_coverage(part, controller->touched());
+          if (job.progress && t_s >= next_progress_s) {
+            job.progress(t_s, coverage);
+            next_progress_s += 10.0;
+          }
+          if (job.until_complete && coverage >= 1.0 && drained.load()) {
+            result.complete = true;
+            return false;
+          }
+          return !(t_s >= duration_s && (drained.load() || t_s >= duration_s + kCatchUpS));
+        },
+        runner_error);
+    // One more update, so a safe state reaches the mill (hold, then stop), then everything stops.
+    std::this_thread::sleep_for(std::chrono::milliseconds(2 * kUpdateNs / 1'000'000));
+    stop.store(true);
+    machine_thread.join();
+    records_thread.join();
+    fake_runner.reset();
+    if (!ran) {
+      result.started = false;
+      result.error = runner_error;
+      return result;
+    }
+    machined.flush();
+    return finish_result(result, part, *controller, *machine, machined, link, controller->statistics().compute,
+                         static_cast<double>(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() - start_ns) / 1e9,
+                         wall_start, mill, true);
+  }
+  const hal::MonotonicNs start_ns = (machine_clock.now_ns() / kPeriodNs + 1) * kPeriodNs;
+  hal::MonotonicNs cycle_ns = start_ns;
+  hal::MonotonicNs next_update_ns = start_ns;
   control::MicrosecondHistogram compute;
   double next_progress_s = 10.0;
   bool stop_after_update = false;
@@ -281,42 +423,15 @@ SimResult run_fast(const SimJob& job) {
     }
   }
   machined.flush();
-
-  const stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
-  result.cycles = controller->statistics().cycles;
-  result.overruns = controller->statistics().overruns;
-  result.wakeup_latency_us = {0.0, 0.0, 0.0, 0.0};
-  result.compute_us = quantiles_of(compute);
-  result.simulated_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
-  result.gouge_max_depth_mm = machined.max_gouge_mm();
-  result.gouge_measured = machined.gouge_measured();
-  result.gouge_volume_mm3 = volumes.gouge_mm3;
-  result.removed_volume_mm3 = volumes.removed_mm3;
-  result.unmachined_volume_mm3 = volumes.unmachined_mm3;
-  result.reachable_volume_mm3 = volumes.reachable_mm3;
-  result.coverage_fraction = reachable_coverage(part, controller->touched());
-  result.max_force_n = controller->max_force_n();
-  result.max_offset_mm = controller->max_offset_mm();
-  result.machine_updates = machine->statistics().updates;
-  result.machine_take_ups = machine->statistics().take_ups;
-  result.machine_max_lag_mm = machine->statistics().max_lag_mm;
-  result.safe_state = controller->safe_reason();
-  if (machine->fault() != hal::MachineFault::None || machine->state() == control::MachineSideState::Stopped) {
-    result.machine_error = link.last_error();
-  }
-  const stencil::sim::StockZmap& stock = machined.stock();
-  result.columns = stock.columns();
-  result.rows = stock.rows();
-  result.cell_mm = stock.cell_mm();
-  for (int row = 0; row < stock.rows(); ++row) {
-    for (int column = 0; column < stock.columns(); ++column) {
-      result.stock_heights.push_back(stock.height(column, row));
-    }
-  }
-  result.part_heights = machined.part_heights();
-  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
-  mill.set_motion_observer(nullptr);
-  return result;
+  return finish_result(result, part, *controller, *machine, machined, link, compute,
+                       static_cast<double>(cycle_ns - start_ns) / 1e9, wall_start, mill, false);
 }
+
+}  // namespace
+
+SimResult run_fast(const SimJob& job) { return run_job(job, nullptr); }
+
+SimResult run_realtime(const SimJob& job, const PeriodicRunner& runner) { return run_job(job, &runner); }
+
 
 }  // namespace stencil::board::sim

@@ -3,6 +3,7 @@
 // the simulated operator; and the fast run loop that drives them on virtual time.
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <functional>
@@ -14,6 +15,7 @@
 
 #include "firmware/control/safe_state.hpp"
 #include "firmware/tables/part_tables.hpp"
+#include "hal/clock.hpp"
 #include "sim/mill/stock_zmap.hpp"
 #include "sim/operator/operator_script.hpp"
 
@@ -43,7 +45,14 @@ struct SimJob {
   bool until_complete = false;  // end once every reachable triangle is touched and the mill has caught up
   std::FILE* trace = nullptr;   // the mill's true path corners, t_s,x_mm,y_mm,z_mm
   std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
+  const std::atomic<bool>* interrupted = nullptr;  // set by SIGINT/SIGTERM: a stop command to the cycle
 };
+
+// Runs cycle(now_ns, deadline_ns) once per period (on a real-time thread, where the host allows)
+// until it returns false or `stop` is set. False with `error` when it refused to run.
+using PeriodicRunner = std::function<bool(hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+                                          const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
+                                          std::string& error)>;
 
 struct Quantiles {
   double p50, p99, p999, max;
@@ -82,6 +91,11 @@ struct SimResult {
 // Runs the job on virtual time, as fast as the machine allows; the same job gives the same result
 // apart from the wall-clock fields (compute_us, wall_s).
 [[nodiscard]] SimResult run_fast(const SimJob& job);
+
+// Runs the job in real time: the cycle on `runner`'s thread each millisecond, the machine side on a
+// thread of its own at the update rate, the fake CY545 serviced on the pty in real time, the journal
+// and telemetry drained at 20 Hz; overruns count.
+[[nodiscard]] SimResult run_realtime(const SimJob& job, const PeriodicRunner& runner);
 
 // The lowest the part's tool can have its tip over (x, y) without entering the part, from the
 // part's top over a 0.05 mm grid of the stock (the scripted operator's idea of the part).

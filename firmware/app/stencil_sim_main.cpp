@@ -9,12 +9,16 @@
 #include <string>
 #include <vector>
 
+#include <signal.h>
 #include <unistd.h>
+
+#include <atomic>
 
 #include <CLI/CLI.hpp>
 
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
+#include "firmware/app/realtime_thread.hpp"
 #include "firmware/tables/table_loader.hpp"
 
 // The baked-in sample part (the hex prism), linked into its own read-only section.
@@ -28,6 +32,11 @@ using namespace stencil;
 constexpr int kExitDone = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitSafeState = 3;
+
+// Set by SIGINT and SIGTERM: the run ends through the cycle's safe state (a stop command).
+std::atomic<bool> interrupted{false};
+
+void on_signal(int) { interrupted.store(true); }
 
 int bad_input(const std::string& message) {
   std::fprintf(stderr, "stencil-sim: %s\n", message.c_str());
@@ -90,7 +99,18 @@ int main(int argc, char** argv) {
   app.add_option("--seed", seed, "the random pattern's seed")->capture_default_str();
   app.add_option("--duration", duration_s, "simulated seconds to run (default: the script's length)")
       ->check(CLI::NonNegativeNumber);
-  app.add_flag("--fast", fast, "virtual clock, as fast as the machine allows, deterministic (the only mode built so far)");
+  app.add_flag("--fast", fast, "virtual clock, as fast as the machine allows, deterministic");
+  double speed = 0.0;
+  int priority = 80;
+  int cpu = -1;
+  bool require_rt = false;
+  app.add_option("--speed", speed, "real time: 1 (the cycle on a SCHED_FIFO thread at 1 kHz; other speeds are not built)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--priority", priority, "real time: the cycle thread's SCHED_FIFO priority")
+      ->check(CLI::Range(1, 99))
+      ->capture_default_str();
+  app.add_option("--cpu", cpu, "real time: pin the cycle thread to this CPU")->check(CLI::NonNegativeNumber);
+  app.add_flag("--require-rt", require_rt, "real time: refuse to run without SCHED_FIFO and locked memory");
   app.add_option("--report", report_path, "the JSON report; the picture goes beside it as .svg")->capture_default_str();
   app.add_flag("--until-complete", until_complete,
                "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
@@ -106,8 +126,11 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
   }
-  if (!fast) {
-    return bad_input("real-time mode (--speed) is not built yet: pass --fast");
+  if (fast == (speed > 0.0)) {
+    return bad_input(fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed 1 (real time)");
+  }
+  if (speed > 0.0 && speed != 1.0) {
+    return bad_input("--speed " + std::to_string(speed) + ": only 1 (real time) is built so far");
   }
 
   // The part: a table file read into memory, or the baked-in section used in place.
@@ -179,7 +202,26 @@ int main(int argc, char** argv) {
               job.stock.high_mm.z(), job.script.duration_s());
   std::fflush(stdout);
 
-  const board::sim::SimResult result = board::sim::run_fast(job);
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  job.interrupted = &interrupted;
+  board::sim::SimResult result;
+  if (fast) {
+    result = board::sim::run_fast(job);
+  } else {
+    const app::RealtimeOptions options{priority, cpu, require_rt};
+    result = board::sim::run_realtime(
+        job, [&](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+                 const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle, std::string& refused) {
+          const app::RealtimeSetup setup = app::run_periodic(options, period_ns, stop, cycle, [](const std::string& line) {
+            std::fprintf(stderr, "stencil-sim: %s\n", line.c_str());
+          });
+          refused = setup.refused.empty() ? "" : "--require-rt: " + setup.refused;
+          return setup.refused.empty();
+        });
+  }
   if (job.progress) {
     std::fprintf(stderr, "\n");
   }
@@ -188,7 +230,7 @@ int main(int argc, char** argv) {
   }
   if (!result.started) {
     std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
-    return kExitSafeState;
+    return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
   }
   std::printf("%s", board::sim::summary(result).c_str());
   const std::string picture_path =

@@ -1,0 +1,36 @@
+// The cycle's thread: SCHED_FIFO at a priority, optionally pinned to a CPU, memory locked, its stack
+// prefaulted, woken by absolute clock_nanosleep on CLOCK_MONOTONIC once per period. Where the host
+// refuses real-time privileges it says so once and runs anyway, unless they are required.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "hal/clock.hpp"
+
+namespace stencil::app {
+
+struct RealtimeOptions {
+  int priority = 80;      // SCHED_FIFO
+  int cpu = -1;           // pin to this CPU; -1: anywhere
+  bool require = false;   // refuse to run without SCHED_FIFO and locked memory
+};
+
+// What the thread got.
+struct RealtimeSetup {
+  bool sched_fifo = false;
+  bool pinned = false;
+  bool memory_locked = false;
+  std::string refused;  // non-empty: why it did not run (only with require)
+};
+
+// Runs `cycle(now_ns, deadline_ns)` once per period on a new thread until it returns false or `stop`
+// is set; each call's deadline is the absolute start of its period. Blocks until the thread ends.
+// `announce` gets one line per privilege missing (before the first cycle).
+RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+                           const std::function<bool(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns)>& cycle,
+                           const std::function<void(const std::string&)>& announce);
+
+}  // namespace stencil::app
