@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt fuzz bench demo clean help
+.PHONY: all deps build test test-asan test-debug rt fuzz bench demo latency clean help
 
 all: build
 
@@ -11,6 +11,7 @@ help:
 	@echo "make build      build only (binaries in build/bin)"
 	@echo "make bench      time the engine (query, full cycle) beside brute force and FCL: build/bin/stencil-bench"
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
+	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
 
@@ -46,6 +47,12 @@ test-debug: deps
 rt: deps
 	cmake --preset rt-x86_64
 	cmake --build --preset rt-x86_64
+
+# A measurement, not a test: cyclictest, then stencil-sim in real time, each LATENCY_SECONDS (60) on
+# CPU 1 with stress-ng on CPU 0 (needs root for SCHED_FIFO).
+latency: build
+	@bash toolchain/install-deps.sh --latency
+	bash toolchain/latency.sh
 
 # Each fuzz target runs for FUZZ_SECONDS (two at once, one per core): `make fuzz FUZZ_SECONDS=600` for a long run.
 FUZZ_SECONDS ?= 60

@@ -1,19 +1,22 @@
 #!/usr/bin/env bash
 # Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
 # --cross also installs the aarch64-linux-gnu cross compiler and the arm64 libraries the firmware
-# links (zlib), for the `aarch64` preset.
+# links (zlib), for the `aarch64` preset. --latency adds cyclictest and stress-ng for make latency.
 set -euo pipefail
 
 cross=0
+latency=0
 for argument in "$@"; do
   case "$argument" in
     --cross) cross=1 ;;
+    --latency) latency=1 ;;
     -h|--help)
-      echo "usage: $0 [--cross]"
+      echo "usage: $0 [--cross] [--latency]"
       echo "Installs the Debian packages the project needs (apt-get; as root or via sudo)."
       echo "  --cross   also the aarch64-linux-gnu cross compiler (for the aarch64 preset)"
+      echo "  --latency also cyclictest (rt-tests) and stress-ng (for make latency)"
       exit 0 ;;
-    *) echo "install-deps: unknown option '$argument' (expected --cross or --help)" >&2; exit 2 ;;
+    *) echo "install-deps: unknown option '$argument' (expected --cross, --latency or --help)" >&2; exit 2 ;;
   esac
 done
 
@@ -36,6 +39,9 @@ packages=(
 )
 if [ "$cross" -eq 1 ]; then
   packages+=(g++-aarch64-linux-gnu zlib1g-dev:arm64)
+fi
+if [ "$latency" -eq 1 ]; then
+  packages+=(rt-tests stress-ng)
 fi
 
 missing=()
