@@ -22,14 +22,18 @@ fail() {
   failures=$((failures + 1))
 }
 
-run_sim() {
-  echo "\$ stencil-sim $*"
-  "$sim" "$@" >stdout.txt 2>stderr.txt
+# run PROGRAM ARGS...: runs it in the case's folder; sets status, and keeps stdout/stderr in files.
+run() {
+  echo "\$ $(basename "$1") ${*:2}"
+  "$@" >stdout.txt 2>stderr.txt
   status=$?
   sed 's/^/  stdout: /' stdout.txt
   sed 's/^/  stderr: /' stderr.txt
   echo "  exit status $status"
 }
+
+run_sim() { run "$sim" "$@"; }
+run_rig() { run "$rig" "$@"; }
 
 expect_status() {
   [ "$status" -eq "$1" ] || fail "exit status $status; expected $1"
@@ -168,15 +172,6 @@ case_refuses_an_unknown_pattern() {
   run_sim --fast --pattern spiral
   expect_status 2
   expect_stderr "spiral" "the pattern it does not know"
-}
-
-run_rig() {
-  echo "\$ stencil-rig $*"
-  "$rig" "$@" >stdout.txt 2>stderr.txt
-  status=$?
-  sed 's/^/  stdout: /' stdout.txt
-  sed 's/^/  stderr: /' stderr.txt
-  echo "  exit status $status"
 }
 
 # The rig program on a machine without the rig: it checks what it can and says what is missing.

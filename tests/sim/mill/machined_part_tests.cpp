@@ -1,6 +1,7 @@
 // The stock's Z-map and the ground truth of a cut: heights under a ball end mill's pass, what it
 // leaves beside it, and the gouge of a swept cutter against the part's own triangles.
 #include <cmath>
+#include <memory>
 
 #include "firmware/tables/table_loader.hpp"
 #include "sim/mill/machined_part.hpp"
@@ -70,19 +71,30 @@ TEST(StockZmap, NothingIsCutBelowTheFloor) {
   DOUBLES_EQUAL(0.0, stock.height(column, column), 0.0);
 }
 
+// The hex prism's tables, and a machined part over its stock whose frames put step 0 at the world
+// origin, so that world = steps / 640 on every axis.
+struct PrismJob {
+  tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
+  tables::PartTables part{};
+  std::unique_ptr<MachinedPart> machined;
+  PrismJob() {
+    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+    const motion::MachineFrames frames{10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), {1, 1, 1}, 640.0};
+    machined = std::make_unique<MachinedPart>(part, StockBox{{15.0, 3.0, 0.0}, {35.0, 22.0, 7.0}}, frames,
+                                              [] { return 0.0; });
+    machined->arm({0, 0, 0});
+  }
+  static std::array<std::int64_t, 3> at(double x, double y, double z) {
+    return {std::llround(x * 640.0), std::llround(y * 640.0), std::llround(z * 640.0)};
+  }
+};
+
 TEST_GROUP(MachinedPart){};
 
 TEST(MachinedPart, ALegThatCutsIntoThePrismIsAGougeOfItsDepth) {
-  const tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
-  tables::PartTables part{};
-  CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
-  // Frames with step 0 at the world origin, so that world = steps / 640 on every axis.
-  const motion::MachineFrames frames{10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), {1, 1, 1}, 640.0};
-  MachinedPart machined(part, {{15.0, 3.0, 0.0}, {35.0, 22.0, 7.0}}, frames, [] { return 0.0; });
-  machined.arm({0, 0, 0});
-  const auto at = [](double x, double y, double z) {
-    return std::array<std::int64_t, 3>{std::llround(x * 640.0), std::llround(y * 640.0), std::llround(z * 640.0)};
-  };
+  PrismJob job;
+  MachinedPart& machined = *job.machined;
+  const auto at = &PrismJob::at;
   // From the origin (far from the prism) along y, up to z = 5.75, then along x across the prism's
   // middle: the tip is 0.25 mm into its top face (z = 6) there, a gouge of 0.25 mm.
   machined.axis_moved(Axis::y, at(0.0, 12.5, 0.0));
@@ -94,15 +106,9 @@ TEST(MachinedPart, ALegThatCutsIntoThePrismIsAGougeOfItsDepth) {
 }
 
 TEST(MachinedPart, ALegClearOfThePartIsNoGouge) {
-  const tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
-  tables::PartTables part{};
-  CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
-  const motion::MachineFrames frames{10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), {1, 1, 1}, 640.0};
-  MachinedPart machined(part, {{15.0, 3.0, 0.0}, {35.0, 22.0, 7.0}}, frames, [] { return 0.0; });
-  machined.arm({0, 0, 0});
-  const auto at = [](double x, double y, double z) {
-    return std::array<std::int64_t, 3>{std::llround(x * 640.0), std::llround(y * 640.0), std::llround(z * 640.0)};
-  };
+  PrismJob job;
+  MachinedPart& machined = *job.machined;
+  const auto at = &PrismJob::at;
   machined.axis_moved(Axis::z, at(0.0, 0.0, 6.01));
   machined.axis_moved(Axis::x, at(25.0, 0.0, 6.01));
   machined.axis_moved(Axis::y, at(25.0, 12.5, 6.01));  // over the top, 10 um clear
