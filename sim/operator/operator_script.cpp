@@ -142,6 +142,10 @@ bool read_operator_csv(const std::string& path, OperatorScript& script, std::str
     error = path + ": cannot be read";
     return false;
   }
+  return parse_operator_csv(in, path, script, error);
+}
+
+bool parse_operator_csv(std::istream& in, const std::string& path, OperatorScript& script, std::string& error) {
   std::string line;
   int number = 0;
   while (std::getline(in, line)) {

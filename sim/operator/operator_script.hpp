@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <istream>
 #include <random>
 #include <string>
 #include <vector>
@@ -52,8 +53,10 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
 [[nodiscard]] bool parse_finite_field(const std::string& field, double& value);
 
 // A script from CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] (device space, times increasing). On bad
-// input returns false with `error` naming the line and what was expected.
+// input returns false with `error` naming the file (`name`), the line and what was expected.
 [[nodiscard]] bool read_operator_csv(const std::string& path, OperatorScript& script, std::string& error);
+[[nodiscard]] bool parse_operator_csv(std::istream& in, const std::string& name, OperatorScript& script,
+                                      std::string& error);
 
 // The hand: the handle is pulled to the script by a spring of stiffness k (N per device mm), the
 // device pushes back with the rendered force; the handle moves a fraction of the way to where the
