@@ -128,10 +128,17 @@ case_trace_is_written() {
     fail "trace.csv rows are not t_s,x_mm,y_mm,z_mm with t_s increasing"
 }
 
-case_refuses_real_time_mode_not_built() {
+# Neither --fast nor --speed: it asks for one; --speed other than 1 is not built and says so.
+case_refuses_to_run_without_a_clock() {
   run_sim --pattern raster
   expect_status 2
-  expect_stderr "pass --fast" "that only --fast is built"
+  expect_stderr "pass --fast \(virtual time\) or --speed 1 \(real time\)" "the two ways to run"
+  run_sim --speed 5 --pattern raster
+  expect_status 2
+  expect_stderr "--speed 5.0+: only 1 \(real time\) is built so far" "which speeds are built"
+  run_sim --fast --speed 1 --pattern raster
+  expect_status 2
+  expect_stderr "--fast and --speed: choose one" "that the two exclude each other"
 }
 
 case_refuses_a_bad_operator_csv() {
