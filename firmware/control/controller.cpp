@@ -34,8 +34,7 @@ void Controller::write_zero_force() {
   static_cast<void>(device_.write_command(last_command_));
 }
 
-void Controller::enter_safe_state(SafeReason reason, hal::MonotonicNs now_ns) {
-  static_cast<void>(now_ns);
+void Controller::enter_safe_state(SafeReason reason) {
   if (safe_reason_ != SafeReason::None) {
     return;  // latched: the first reason stays
   }
@@ -79,7 +78,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
     }
     switch (command.kind) {
       case CommandKind::Stop:
-        enter_safe_state(SafeReason::Stopped, now_ns);
+        enter_safe_state(SafeReason::Stopped);
         break;
       case CommandKind::Reset:
         last_reset_ = try_reset(now_ns);
@@ -93,7 +92,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       break;
     }
     if (event.kind == MachineEventKind::Fault) {
-      enter_safe_state(SafeReason::MachineFault, now_ns);
+      enter_safe_state(SafeReason::MachineFault);
     }
   }
 }
@@ -111,29 +110,29 @@ bool Controller::read_device(hal::MonotonicNs now_ns) {
     case hal::ReadStatus::Rejected:
       ++counters_.rejected_samples;
       if (read.reason == hal::HapticFault::SampleOutOfRange) {
-        enter_safe_state(SafeReason::PoseOutOfWorkspace, now_ns);
+        enter_safe_state(SafeReason::PoseOutOfWorkspace);
         return false;
       }
       break;
     case hal::ReadStatus::Fault:
-      enter_safe_state(SafeReason::DeviceFault, now_ns);
+      enter_safe_state(SafeReason::DeviceFault);
       return false;
   }
   if (read.status != hal::ReadStatus::Fresh) {
     ++cycles_since_fresh_;
     if (cycles_since_fresh_ > config_.stale_periods) {
-      enter_safe_state(SafeReason::DeviceStale, now_ns);
+      enter_safe_state(SafeReason::DeviceStale);
     }
     return have_sample_ && cycles_since_fresh_ <= config_.stale_periods;
   }
   const Eigen::Vector3d position = position_of(sample);
   if (!position.allFinite() || !std::isfinite(sample.angles_rad[0]) || !std::isfinite(sample.angles_rad[1])) {
-    enter_safe_state(SafeReason::PoseNotFinite, now_ns);
+    enter_safe_state(SafeReason::PoseNotFinite);
     return false;
   }
   if ((position.array() < config_.device_low_mm.array()).any() ||
       (position.array() > config_.device_high_mm.array()).any()) {
-    enter_safe_state(SafeReason::PoseOutOfWorkspace, now_ns);
+    enter_safe_state(SafeReason::PoseOutOfWorkspace);
     return false;
   }
   if (have_sample_) {
@@ -142,7 +141,7 @@ bool Controller::read_device(hal::MonotonicNs now_ns) {
     const double seconds = static_cast<double>(now_ns - sample_time_ns_) / kNsPerS;
     const double moved = (position - position_of(sample_)).norm();
     if (moved > config_.max_device_speed_mm_per_s * std::max(seconds, 1e-3)) {
-      enter_safe_state(SafeReason::PoseJump, now_ns);
+      enter_safe_state(SafeReason::PoseJump);
       return false;
     }
     if (seconds > 0.0 && moved > config_.still_speed_mm_per_s * seconds) {
@@ -169,7 +168,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     still_since_ns_ = now_ns;
   }
   if (!ready_) {
-    enter_safe_state(SafeReason::EngineFault, now_ns);
+    enter_safe_state(SafeReason::EngineFault);
   }
   handle_commands(now_ns);
   const bool usable = read_device(now_ns);
@@ -188,7 +187,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     output = engine::haptic_output(desired, tool_.tip_mm(), contact, config_.haptic);
     if (contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
         output.fault) {
-      enter_safe_state(SafeReason::EngineFault, now_ns);
+      enter_safe_state(SafeReason::EngineFault);
     } else {
       static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
                                              touched_));
@@ -212,7 +211,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
                      usable};
     max_force_n_ = std::max(max_force_n_, force.norm());
     if (device_.write_command(last_command_).status == hal::WriteStatus::Fault) {
-      enter_safe_state(SafeReason::DeviceFault, now_ns);
+      enter_safe_state(SafeReason::DeviceFault);
     }
   } else {
     write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
@@ -229,14 +228,14 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   copy3(tool_.tip_mm(), record.virtual_tip_mm);
   record.safe_reason = safe_reason_;  // as it stands before the machine handoff below
   if (!rings_.journal.push(record)) {
-    enter_safe_state(SafeReason::JournalFull, now_ns);  // the record is lost: say so, stop cutting
+    enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
   }
 
   // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
   MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
   copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
   if (!rings_.machine.push(handoff)) {
-    enter_safe_state(SafeReason::MachineFault, now_ns);
+    enter_safe_state(SafeReason::MachineFault);
   }
 
   telemetry.cycle = cycle_;
@@ -265,7 +264,7 @@ void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_
   if (end_ns > next_deadline_ns) {
     ++statistics_.overruns;
     if (++consecutive_overruns_ > config_.overrun_limit) {
-      enter_safe_state(SafeReason::OverrunStorm, end_ns);
+      enter_safe_state(SafeReason::OverrunStorm);
     }
   } else {
     consecutive_overruns_ = 0;

@@ -11,7 +11,6 @@
 #include "firmware/control/cycle_messages.hpp"
 #include "firmware/control/loop_statistics.hpp"
 #include "firmware/control/safe_state.hpp"
-#include "firmware/control/spsc_ring.hpp"
 #include "firmware/motion/machine_frames.hpp"
 #include "firmware/stencil/contact_query.hpp"
 #include "firmware/stencil/haptic_force.hpp"
@@ -21,22 +20,6 @@
 #include "hal/haptic_device.hpp"
 
 namespace stencil::control {
-
-// The rings around the cycle: capacities in the types. The machine side drains its ring at each
-// machine update (about 30 Hz), so it holds well over a machine update's worth of cycles.
-using CommandRing = SpscRing<Command, 16>;
-using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
-using MachineEventRing = SpscRing<MachineEvent, 16>;
-using TelemetryRing = SpscRing<Telemetry, 64>;
-using JournalRing = SpscRing<JournalRecord, 4096>;
-
-struct CycleRings {
-  CommandRing& commands;          // in: reset, stop
-  MachineEventRing& machine_events;  // in: the machine side's faults
-  MachineHandoffRing& machine;    // out: every cycle's virtual tool
-  TelemetryRing& telemetry;       // out: dropped and counted when full
-  JournalRing& journal;           // out: full is a fault
-};
 
 // What a board decides about the cycle (the rig's numbers by default).
 struct ControllerConfig {
@@ -109,7 +92,7 @@ class Controller {
   [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
 
  private:
-  void enter_safe_state(SafeReason reason, hal::MonotonicNs now_ns);
+  void enter_safe_state(SafeReason reason);
   void write_zero_force();
   void handle_commands(hal::MonotonicNs now_ns);
   [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "firmware/control/safe_state.hpp"
+#include "firmware/control/spsc_ring.hpp"
 #include "firmware/stencil/virtual_tool.hpp"
 
 namespace stencil::control {
@@ -70,6 +71,22 @@ struct JournalRecord {
   bool fresh;                // a new sample this cycle
   double virtual_tip_mm[3];
   SafeReason safe_reason;    // as latched at the end of the cycle
+};
+
+// The rings around the cycle: capacities in the types. The machine side drains its ring at each
+// machine update (about 30 Hz), so it holds well over a machine update's worth of cycles.
+using CommandRing = SpscRing<Command, 16>;
+using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
+using MachineEventRing = SpscRing<MachineEvent, 16>;
+using TelemetryRing = SpscRing<Telemetry, 64>;
+using JournalRing = SpscRing<JournalRecord, 4096>;
+
+struct CycleRings {
+  CommandRing& commands;          // in: reset, stop
+  MachineEventRing& machine_events;  // in: the machine side's faults
+  MachineHandoffRing& machine;    // out: every cycle's virtual tool
+  TelemetryRing& telemetry;       // out: dropped and counted when full
+  JournalRing& journal;           // out: full is a fault
 };
 
 }  // namespace stencil::control

@@ -7,8 +7,6 @@
 #include <cstdint>
 
 #include "firmware/control/cycle_messages.hpp"
-#include "firmware/control/spsc_ring.hpp"
-#include "firmware/control/controller.hpp"
 #include "firmware/motion/machine_planner.hpp"
 #include "hal/clock.hpp"  // MonotonicNs
 #include "hal/machine_link.hpp"

@@ -171,34 +171,34 @@ double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3
   return deepest;
 }
 
-std::vector<double> part_top_heights(const tables::PartTables& part_, const StockZmap& stock_) {
+std::vector<double> part_top_heights(const tables::PartTables& part, const StockZmap& grid) {
   // The part's top over each cell centre: the highest triangle above it (the part stands on the
   // floor; a cell with no part over it is the floor's height).
-  std::vector<double> heights(static_cast<std::size_t>(stock_.columns()) * static_cast<std::size_t>(stock_.rows()),
-                              stock_.box().low_mm.z());
-  const double cell = stock_.cell_mm();
-  const Eigen::Vector3d origin = stock_.box().low_mm;
-  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
-    const Eigen::Vector3d a = vertex(part_.triangles[t], 0), b = vertex(part_.triangles[t], 1),
-                          c = vertex(part_.triangles[t], 2);
+  std::vector<double> heights(static_cast<std::size_t>(grid.columns()) * static_cast<std::size_t>(grid.rows()),
+                              grid.box().low_mm.z());
+  const double cell = grid.cell_mm();
+  const Eigen::Vector3d origin = grid.box().low_mm;
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    const Eigen::Vector3d a = vertex(part.triangles[t], 0), b = vertex(part.triangles[t], 1),
+                          c = vertex(part.triangles[t], 2);
     const double area = (b.x() - a.x()) * (c.y() - a.y()) - (c.x() - a.x()) * (b.y() - a.y());
     if (std::abs(area) < 1e-12) {
       continue;  // seen edge-on from above: a wall
     }
     const int c0 = std::max(0, static_cast<int>(std::floor((std::min({a.x(), b.x(), c.x()}) - origin.x()) / cell)));
-    const int c1 = std::min(stock_.columns() - 1, static_cast<int>(std::floor((std::max({a.x(), b.x(), c.x()}) - origin.x()) / cell)));
+    const int c1 = std::min(grid.columns() - 1, static_cast<int>(std::floor((std::max({a.x(), b.x(), c.x()}) - origin.x()) / cell)));
     const int r0 = std::max(0, static_cast<int>(std::floor((std::min({a.y(), b.y(), c.y()}) - origin.y()) / cell)));
-    const int r1 = std::min(stock_.rows() - 1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - origin.y()) / cell)));
+    const int r1 = std::min(grid.rows() - 1, static_cast<int>(std::floor((std::max({a.y(), b.y(), c.y()}) - origin.y()) / cell)));
     for (int row = r0; row <= r1; ++row) {
       for (int column = c0; column <= c1; ++column) {
-        const Eigen::Vector2d p = stock_.centre(column, row);
+        const Eigen::Vector2d p = grid.centre(column, row);
         const double w0 = ((b.x() - p.x()) * (c.y() - p.y()) - (c.x() - p.x()) * (b.y() - p.y())) / area;
         const double w1 = ((c.x() - p.x()) * (a.y() - p.y()) - (a.x() - p.x()) * (c.y() - p.y())) / area;
         const double w2 = 1.0 - w0 - w1;
         if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) {
           continue;
         }
-        double& height = heights[static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) +
+        double& height = heights[static_cast<std::size_t>(row) * static_cast<std::size_t>(grid.columns()) +
                                  static_cast<std::size_t>(column)];
         height = std::max(height, w0 * a.z() + w1 * b.z() + w2 * c.z());
       }

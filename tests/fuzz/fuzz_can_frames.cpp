@@ -9,14 +9,10 @@
 
 #include "hal/haptic_device.hpp"
 #include "hal/socketcan/can_codec.hpp"
+#include "tests/fuzz/fuzz_require.hpp"
 
-namespace {
-void require(bool promise) {
-  if (!promise) {
-    __builtin_trap();
-  }
-}
-}  // namespace
+using stencil::fuzz::require;
+
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::hal;

@@ -4,14 +4,10 @@
 #include <string_view>
 
 #include "hal/cy545/cy545_commands.hpp"
+#include "tests/fuzz/fuzz_require.hpp"
 
-namespace {
-void require(bool promise) {
-  if (!promise) {
-    __builtin_trap();
-  }
-}
-}  // namespace
+using stencil::fuzz::require;
+
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size == 0) {

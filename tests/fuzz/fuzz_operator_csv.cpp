@@ -7,14 +7,10 @@
 #include <string>
 
 #include "sim/operator/operator_script.hpp"
+#include "tests/fuzz/fuzz_require.hpp"
 
-namespace {
-void require(bool promise) {
-  if (!promise) {
-    __builtin_trap();
-  }
-}
-}  // namespace
+using stencil::fuzz::require;
+
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::istringstream in(std::string(reinterpret_cast<const char*>(data), size));

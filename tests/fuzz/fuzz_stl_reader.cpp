@@ -8,15 +8,11 @@
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/part_mesh.hpp"
 #include "toolchain/tablegen/stl_reader.hpp"
+#include "tests/fuzz/fuzz_require.hpp"
+
+using stencil::fuzz::require;
 
 namespace {
-
-// A broken promise of the parser (not a crash by itself): stop so libFuzzer keeps the input.
-void require(bool promise) {
-  if (!promise) {
-    __builtin_trap();
-  }
-}
 
 // What parse_stl promises for every mesh it returns.
 void check_mesh(const stencil::tablegen::StlMesh& mesh) {
@@ -49,6 +45,7 @@ void check_part(const stencil::tablegen::PartMesh& part, const stencil::tablegen
 }
 
 }  // namespace
+
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::tablegen;

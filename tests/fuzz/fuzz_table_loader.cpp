@@ -9,15 +9,11 @@
 
 #include "firmware/tables/table_format.hpp"
 #include "firmware/tables/table_loader.hpp"
+#include "tests/fuzz/fuzz_require.hpp"
+
+using stencil::fuzz::require;
 
 namespace {
-
-// A broken promise of the loader (not a crash by itself): stop so libFuzzer keeps the input.
-void require(bool promise) {
-  if (!promise) {
-    __builtin_trap();
-  }
-}
 
 // The loader needs an 8-byte aligned buffer. This one has exactly the input's size, so ASan's
 // redzones sit right after the last byte and catch any read past it.
@@ -76,6 +72,7 @@ void walk(const stencil::tables::PartTables& tables) {
 }
 
 }  // namespace
+
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::tables;
