@@ -202,6 +202,19 @@ int main(int argc, char** argv) {
               job.stock.high_mm.z(), job.script.duration_s());
   std::fflush(stdout);
 
+  const std::string picture_path =
+      (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
+           ? report_path.substr(0, report_path.size() - 5)
+           : report_path) +
+      ".svg";
+  // The outputs can be written: found out now, not after the whole simulated job (every input has
+  // been checked by now, so bad input leaves no report behind).
+  for (const std::string& path : {report_path, picture_path}) {
+    std::ofstream probe(path, std::ios::app);
+    if (!probe) {
+      return bad_input(path + ": cannot be written");
+    }
+  }
   struct sigaction action {};
   action.sa_handler = on_signal;
   sigaction(SIGINT, &action, nullptr);
@@ -233,11 +246,6 @@ int main(int argc, char** argv) {
     return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
   }
   std::printf("%s", board::sim::summary(result).c_str());
-  const std::string picture_path =
-      (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
-           ? report_path.substr(0, report_path.size() - 5)
-           : report_path) +
-      ".svg";
   if (!board::sim::write_report_json(report_path, result, error) ||
       !board::sim::write_picture_svg(picture_path, result, error)) {
     return bad_input(error);

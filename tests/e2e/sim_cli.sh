@@ -149,6 +149,29 @@ case_refuses_a_bad_operator_csv() {
   [ ! -e report.json ] || fail "a report was written for bad input"
 }
 
+case_refuses_a_row_of_the_wrong_length_an_empty_file_and_a_missing_one() {
+  printf '0,250,125,200\n1,250,125\n' >operator.csv
+  run_sim --fast --operator operator.csv
+  expect_status 2
+  expect_stderr "operator.csv: line 2: 3 fields; expected t_s,x_mm,y_mm,z_mm\[,a_rad,b_rad\]" "the line and the fields expected"
+  : >empty.csv
+  run_sim --fast --operator empty.csv
+  expect_status 2
+  expect_stderr "empty.csv: no rows; expected t_s,x_mm,y_mm,z_mm" "that the file has no rows"
+  run_sim --fast --operator missing.csv
+  expect_status 2
+  expect_stderr "missing.csv: cannot be read" "the missing file"
+}
+
+case_refuses_outputs_it_cannot_write_before_running() {
+  run_sim --fast --report no-such-folder/report.json
+  expect_status 2
+  expect_stderr "no-such-folder/report.json: cannot be written" "the report path"
+  run_sim --fast --trace no-such-folder/trace.csv
+  expect_status 2
+  expect_stderr "no-such-folder/trace.csv: cannot be written" "the trace path"
+}
+
 case_refuses_times_that_do_not_increase() {
   printf '0,250,125,200\n1,250,125,190\n1,250,125,180\n' >operator.csv
   run_sim --fast --operator operator.csv
@@ -160,6 +183,9 @@ case_refuses_a_bad_stock() {
   run_sim --fast --stock 1,2,3
   expect_status 2
   expect_stderr "--stock 1,2,3: 3 numbers; expected X0,Y0,Z0,X1,Y1,Z1" "the option and what it expects"
+  run_sim --fast --stock 10,10,0,5,20,x7
+  expect_status 2
+  expect_stderr "--stock 10,10,0,5,20,x7: 'x7' is not a number" "the field that is not a number"
   run_sim --fast --stock 10,10,0,5,20,7
   expect_status 2
   expect_stderr "--stock 10,10,0,5,20,7: axis x must have 0 <= low < high" "the axis at fault"
@@ -195,6 +221,9 @@ case_rig_without_the_hardware_fails_cleanly() {
   run_rig --tables part.stbl --serial missing-port --haptic can:can0
   expect_status 3
   expect_stderr "missing-port" "the missing serial port by name"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic pio:
+  expect_status 2
+  expect_stderr "--haptic pio:: expected pio:/dev/uioN or can:IFACE" "an empty device path"
   run_rig --tables part.stbl --serial /dev/ttyS0 --haptic usb:0
   expect_status 2
   expect_stderr "--haptic usb:0: expected pio:/dev/uioN or can:IFACE" "the option and what it expects"
