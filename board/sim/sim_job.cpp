@@ -174,6 +174,7 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
   const stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
   result.cycles = controller.statistics().cycles;
   result.overruns = controller.statistics().overruns;
+  result.missed_periods = controller.statistics().missed_periods;
   // On virtual time every cycle starts on its deadline: no wake-up latency to speak of.
   result.wakeup_latency_us = realtime ? quantiles_of(controller.statistics().wakeup_latency) : Quantiles{0.0, 0.0, 0.0, 0.0};
   result.compute_us = quantiles_of(compute);
@@ -204,6 +205,7 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
     }
   }
   result.part_heights = machined.part_heights();
+  result.unmachined_heights = machined.unmachined_heights();
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   mill.set_motion_observer(nullptr);
   return result;

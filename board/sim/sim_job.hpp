@@ -63,6 +63,7 @@ struct SimResult {
   std::string error;
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;
+  std::uint64_t missed_periods = 0;  // skipped after the cycle woke too late for them (real time)
   Quantiles wakeup_latency_us{};  // on virtual time: always 0
   Quantiles compute_us{};         // wall clock: the cycle's own work
   double simulated_s = 0.0;
@@ -82,10 +83,11 @@ struct SimResult {
   control::SafeReason safe_state = control::SafeReason::None;
   std::string machine_error;  // the machine link's last error, when it faulted
   bool complete = false;  // until_complete met
-  // The machined stock and the part's top, for the picture: heights per cell, row-major.
+  // The machined stock, the part's top and what is left to cut, for the picture: heights per cell, row-major.
   int columns = 0, rows = 0;
   double cell_mm = 0.0;
   std::vector<double> stock_heights, part_heights;
+  std::vector<double> unmachined_heights;  // stock this tool could still remove over each cell, mm thick
 };
 
 // Runs the job on virtual time, as fast as the machine allows; the same job gives the same result

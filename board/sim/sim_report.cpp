@@ -21,6 +21,7 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
   nlohmann::json report = {
       {"cycles", r.cycles},
       {"overruns", r.overruns},
+      {"missed_periods", r.missed_periods},
       {"simulated_s", r.simulated_s},
       {"wall_s", r.wall_s},
       {"wakeup_latency_us", quantiles_json(r.wakeup_latency_us)},
@@ -68,6 +69,12 @@ std::string summary(const SimResult& r) {
                 r.compute_us.p999, r.compute_us.max,
                 r.safe_state == control::SafeReason::None ? "none" : control::safe_reason_name(r.safe_state));
   std::string out = text;
+  if (r.wakeup_latency_us.max > 0.0) {  // real time: how late the cycle woke, and what that cost
+    std::snprintf(text, sizeof text, "cycle wake-up latency p99 %.1f us, p99.9 %.1f us, max %.1f us; %llu overruns, %llu periods skipped\n",
+                  r.wakeup_latency_us.p99, r.wakeup_latency_us.p999, r.wakeup_latency_us.max,
+                  static_cast<unsigned long long>(r.overruns), static_cast<unsigned long long>(r.missed_periods));
+    out += text;
+  }
   if (!r.machine_error.empty()) {
     out += "machine: " + r.machine_error + "\n";
   }
@@ -98,28 +105,36 @@ bool write_picture_svg(const std::string& path, const SimResult& r, std::string&
   std::fprintf(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" font-family=\"sans-serif\" font-size=\"12\">\n",
                width, height);
   std::fprintf(out, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
-  std::fprintf(out, "<text x=\"10\" y=\"16\">stock as machined (darker is lower; red: cut below the part)</text>\n");
+  std::fprintf(out, "<text x=\"10\" y=\"16\">stock as machined (darker is lower; red: cut below the part; blue: left that this tool could remove)</text>\n");
   std::fprintf(out, "<text x=\"%.0f\" y=\"16\">the part's top</text>\n", 20.0 + columns * size);
   for (int panel = 0; panel < 2; ++panel) {
     const std::vector<double>& grid = panel == 0 ? r.stock_heights : r.part_heights;
     const double x0 = 10.0 + panel * (columns * size + 10.0);
     for (int br = 0; br < rows; ++br) {
       for (int bc = 0; bc < columns; ++bc) {
-        double value = -1e300, gouge = 0.0;
+        double value = -1e300, gouge = 0.0, left = 0.0;
         for (int row = br * block; row < std::min(r.rows, (br + 1) * block); ++row) {
           for (int column = bc * block; column < std::min(r.columns, (bc + 1) * block); ++column) {
             const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(r.columns) +
                                   static_cast<std::size_t>(column);
             value = std::max(value, grid[i]);
             gouge = std::max(gouge, r.part_heights[i] - r.stock_heights[i]);
+            if (i < r.unmachined_heights.size()) {
+              left = std::max(left, r.unmachined_heights[i]);
+            }
           }
         }
         const int grey = static_cast<int>(40.0 + 200.0 * std::clamp((value - low) / span, 0.0, 1.0));
         const bool warn = panel == 0 && gouge > 0.005;
+        // More than a hundredth of a millimetre left is shown, deeper blue for more (full at 0.5 mm).
+        const bool unmachined = panel == 0 && !warn && left > 0.01;
+        const int shade = static_cast<int>(200.0 * (1.0 - std::clamp(left / 0.5, 0.0, 1.0)));
         // Rows run up the picture as y runs up the world.
         std::fprintf(out, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"%s\"/>\n", x0 + bc * size,
                      30.0 + (rows - 1 - br) * size, size, size,
-                     warn ? "#e0201c" : ("rgb(" + std::to_string(grey) + "," + std::to_string(grey) + "," + std::to_string(grey) + ")").c_str());
+                     warn         ? "#e0201c"
+                     : unmachined ? ("rgb(" + std::to_string(shade) + "," + std::to_string(shade) + ",255)").c_str()
+                                  : ("rgb(" + std::to_string(grey) + "," + std::to_string(grey) + "," + std::to_string(grey) + ")").c_str());
       }
     }
   }

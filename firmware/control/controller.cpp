@@ -163,6 +163,11 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   ++cycle_;
   step_start_ns_ = now_ns;
   statistics_.wakeup_latency.add(now_ns - deadline_ns);
+  const hal::MonotonicNs period_ns = next_deadline_ns_ - step_deadline_ns_;
+  if (next_deadline_ns_ != 0 && period_ns > 0 && deadline_ns > next_deadline_ns_) {
+    statistics_.missed_periods += static_cast<std::uint64_t>((deadline_ns - next_deadline_ns_) / period_ns);
+  }
+  step_deadline_ns_ = deadline_ns;
   if (cycle_ == 1) {
     ramp_start_ns_ = now_ns;
     still_since_ns_ = now_ns;
@@ -257,6 +262,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
 
 void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns) {
   statistics_.compute.add(end_ns - step_start_ns_);
+  next_deadline_ns_ = next_deadline_ns;
   ++statistics_.cycles;
   if (!config_.count_overruns) {
     return;

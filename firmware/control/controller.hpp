@@ -121,6 +121,8 @@ class Controller {
   bool ramping_ = true;
   int consecutive_overruns_ = 0;
   hal::MonotonicNs step_start_ns_ = 0;
+  hal::MonotonicNs step_deadline_ns_ = 0;
+  hal::MonotonicNs next_deadline_ns_ = 0;  // from the last finish(): when the next step was due
   hal::HapticCommand last_command_{};
   double max_force_n_ = 0.0;
   double max_offset_mm_ = 0.0;

@@ -35,6 +35,7 @@ struct LoopStatistics {
   MicrosecondHistogram compute;         // how long the cycle's step took
   std::uint64_t cycles = 0;
   std::uint64_t overruns = 0;           // steps that ended after the next period's deadline
+  std::uint64_t missed_periods = 0;     // periods skipped because the cycle woke after they were due
 };
 
 }  // namespace stencil::control

@@ -209,34 +209,60 @@ std::vector<double> part_top_heights(const tables::PartTables& part, const Stock
 
 std::vector<double> MachinedPart::part_heights() const { return part_top_heights(part_, stock_); }
 
-MachinedPart::Volumes MachinedPart::volumes() const {
-  const std::vector<double> part = part_heights();
+std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& part) const {
   const int columns = stock_.columns(), rows = stock_.rows();
-  const double cell = stock_.cell_mm();
-  const double floor = stock_.box().low_mm.z();
   const double top = stock_.box().high_mm.z();
-  const auto at = [&](const std::vector<double>& grid, int column, int row) -> double {
-    return grid[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)];
-  };
   const std::vector<double> tip = lowest_tips(stock_, part, tool_);
-  // The lowest the tool's surface can come over each cell from any of those tips: the reachable
-  // surface.
+  // The lowest the tool's surface can come over each cell from any of those tips.
   const std::vector<Offset> footprint = footprint_of(stock_, tool_);
   const auto inside = [&](int c, int r) { return r >= 0 && r < rows && c >= 0 && c < columns; };
-  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0};
+  std::vector<double> reachable(part.size(), top);
   for (int row = 0; row < rows; ++row) {
     for (int column = 0; column < columns; ++column) {
-      double reachable = top;
+      const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column);
+      double lowest = top;
       for (const Offset& o : footprint) {
         if (inside(column + o.dc, row + o.dr)) {
-          reachable = std::min(reachable, at(tip, column + o.dc, row + o.dr) + o.lift);
+          lowest = std::min(lowest, tip[static_cast<std::size_t>(row + o.dr) * static_cast<std::size_t>(columns) +
+                                        static_cast<std::size_t>(column + o.dc)] +
+                                        o.lift);
         }
       }
-      reachable = std::max(reachable, at(part, column, row));
-      const double left = stock_.height(column, row);
-      v.reachable_mm3 += std::max(0.0, top - reachable);
-      v.unmachined_mm3 += std::max(0.0, left - std::max(reachable, floor)) * (reachable < top ? 1.0 : 0.0);
-      v.gouge_mm3 += std::max(0.0, at(part, column, row) - left);
+      reachable[i] = std::max(lowest, part[i]);
+    }
+  }
+  return reachable;
+}
+
+std::vector<double> MachinedPart::unmachined_heights() const {
+  const std::vector<double> reachable = reachable_heights(part_heights());
+  const double floor = stock_.box().low_mm.z();
+  const double top = stock_.box().high_mm.z();
+  std::vector<double> left(reachable.size(), 0.0);
+  for (int row = 0; row < stock_.rows(); ++row) {
+    for (int column = 0; column < stock_.columns(); ++column) {
+      const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) + static_cast<std::size_t>(column);
+      if (reachable[i] < top) {
+        left[i] = std::max(0.0, stock_.height(column, row) - std::max(reachable[i], floor));
+      }
+    }
+  }
+  return left;
+}
+
+MachinedPart::Volumes MachinedPart::volumes() const {
+  const std::vector<double> part = part_heights();
+  const std::vector<double> reachable = reachable_heights(part);
+  const std::vector<double> left = unmachined_heights();
+  const double cell = stock_.cell_mm();
+  const double top = stock_.box().high_mm.z();
+  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0};
+  for (int row = 0; row < stock_.rows(); ++row) {
+    for (int column = 0; column < stock_.columns(); ++column) {
+      const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) + static_cast<std::size_t>(column);
+      v.reachable_mm3 += std::max(0.0, top - reachable[i]);
+      v.unmachined_mm3 += left[i];
+      v.gouge_mm3 += std::max(0.0, part[i] - stock_.height(column, row));
     }
   }
   v.reachable_mm3 *= cell * cell;

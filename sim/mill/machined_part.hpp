@@ -71,6 +71,8 @@ class MachinedPart final : public MillMotionObserver {
   };
   [[nodiscard]] Volumes volumes() const;
   [[nodiscard]] std::vector<double> part_heights() const;
+  // Over each cell, the stock still there that this tool could have removed (mm thick), row-major.
+  [[nodiscard]] std::vector<double> unmachined_heights() const;
   [[nodiscard]] const ToolProfile& tool() const { return tool_; }
 
  private:
@@ -78,6 +80,8 @@ class MachinedPart final : public MillMotionObserver {
   void finish_leg();
   [[nodiscard]] double leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
   void corner(const Eigen::Vector3d& tip);
+  // The lowest the tool's surface can come over each cell from any legal tip (the reachable surface).
+  [[nodiscard]] std::vector<double> reachable_heights(const std::vector<double>& part) const;
 
   const tables::PartTables& part_;
   motion::MachineFrames frames_;

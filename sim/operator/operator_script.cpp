@@ -15,6 +15,68 @@ constexpr double kRepositionFactor = 2.0 / 3.0;
 // Thin-wall sweeps are meant to be too fast: the speed limit and the sweep check hold the tool.
 constexpr double kSweepFactor = 10.0;
 
+// The raster's passes meet a wall only where they cross it, 1 mm apart in x (2 mm along a wall at
+// 60 degrees), and leave a cusp of stock the height of the wall between each two. A machinist ends
+// with a finishing pass around the part at full depth; this one is as careless as the passes:
+// around the part at the floor, pressed `press` mm into its walls, the stencil holding the tool on
+// them. The way round is found from the middle of what the tool cannot reach at the floor, looking
+// out in each direction for where that region ends (a star-shaped outline is followed exactly).
+void add_finishing_pass(OperatorScript& script, const StockBox& stock, double press, double speed_mm_per_s,
+                        double scale, const std::function<double(double, double)>& touch_tip) {
+  constexpr double kGrid = 0.2;   // mm, the search for the blocked region's middle
+  constexpr double kMarch = 0.05; // mm, the search outward along each direction
+  constexpr int kDirections = 720;
+  const Eigen::Vector3d& low = stock.low_mm;
+  const Eigen::Vector3d& high = stock.high_mm;
+  const auto blocked = [&](double x, double y) { return touch_tip(x, y) > low.z() + 0.01; };
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  int count = 0;
+  for (double y = low.y(); y <= high.y(); y += kGrid) {
+    for (double x = low.x(); x <= high.x(); x += kGrid) {
+      if (blocked(x, y)) {
+        sum += Eigen::Vector2d(x, y);
+        ++count;
+      }
+    }
+  }
+  if (count == 0) {
+    return;  // no part in the stock: nothing to finish
+  }
+  const Eigen::Vector2d centre = sum / count;
+  if (!blocked(centre.x(), centre.y())) {
+    return;  // not star-shaped about its middle: no way round found this way
+  }
+  std::vector<Eigen::Vector2d> ring;
+  Eigen::Vector2d approach = centre;
+  const double reach = (high.head<2>() - low.head<2>()).norm();
+  for (int i = 0; i < kDirections; ++i) {
+    const double angle = 2.0 * M_PI * i / kDirections;
+    const Eigen::Vector2d u(std::cos(angle), std::sin(angle));
+    // Out from the middle to the last blocked point before the open floor or the stock's edge.
+    double edge = 0.0;
+    for (double r = 0.0; r <= reach; r += kMarch) {
+      const Eigen::Vector2d p = centre + r * u;
+      if (p.x() < low.x() || p.x() > high.x() || p.y() < low.y() || p.y() > high.y() || !blocked(p.x(), p.y())) {
+        break;
+      }
+      edge = r;
+    }
+    ring.push_back(centre + std::max(0.0, edge - press) * u);
+    if (i == 0) {
+      approach = centre + (edge + 1.0) * u;  // down to the floor in the open, then in to the wall
+    }
+  }
+  const double floor = low.z();
+  const double above = high.z() + 1.0;
+  approach = approach.cwiseMax(low.head<2>()).cwiseMin(high.head<2>());
+  walk_to(script, {approach.x(), approach.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
+  walk_to(script, {approach.x(), approach.y(), floor}, kRepositionFactor * speed_mm_per_s, scale);
+  for (const Eigen::Vector2d& p : ring) {
+    walk_to(script, {p.x(), p.y(), floor}, speed_mm_per_s, scale);
+  }
+  walk_to(script, {ring.front().x(), ring.front().y(), floor}, speed_mm_per_s, scale);
+}
+
 }  // namespace
 
 Eigen::Vector3d OperatorScript::position_at(double t) const {
@@ -87,6 +149,7 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
         walk_to(script, {high.x(), forward ? low.y() : high.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
         walk_to(script, {low.x(), low.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
       }
+      add_finishing_pass(script, stock, kPress, speed_mm_per_s, scale, touch_tip);
       break;
     }
     case Pattern::Plunge:

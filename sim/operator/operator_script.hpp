@@ -40,7 +40,8 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
 // lowest the tool's tip can be over (x, y) without entering the part (the floor where it is clear):
 // raster: levels 1 mm apart from the stock's top down to the floor, passes along y 1 mm apart in x;
 //   where a pass meets the part it rides over it 1 mm too deep (a careless operator), so the
-//   stencil holds the tool on the part;
+//   stencil holds the tool on the part; then one finishing pass around the part at the floor,
+//   pressed 1 mm into its walls, for the cusps the passes leave between them on the walls;
 // plunge: straight down to the floor at points 2 mm apart, through the part where it is there;
 // thinwall: fast sweeps straight across the stock at several heights, through whatever is there;
 // random: a random walk over and into the stock (seeded).

@@ -257,6 +257,24 @@ TEST(Controller, MoreThanThreeOverrunsInARowEnterTheSafeStateButThreeDoNot) {
   CHECK_FALSE(bench.device.last_command().enable);
 }
 
+TEST(Controller, AStallThatSkipsPeriodsIsOneOverrunAndTheSkippedPeriodsAreCounted) {
+  Bench bench;
+  bench.cycles(20);
+  // The host stalls the cycle for 4.5 ms: the step due at `now` starts 4.5 ms late, and the runner
+  // skips the four periods that went by, so the next step is due at now + 5 ms.
+  for (int stall = 0; stall < 5; ++stall) {
+    const hal::MonotonicNs due = bench.now;
+    static_cast<void>(bench.controller->step(due + 4'500'000, due));
+    bench.controller->finish(due + 4'600'000, due + kPeriodNs);
+    bench.now = due + 5 * kPeriodNs;
+    bench.cycles(2);  // on time again
+  }
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  LONGS_EQUAL(5, bench.controller->statistics().overruns);
+  LONGS_EQUAL(20, bench.controller->statistics().missed_periods);
+  CHECK(bench.controller->statistics().wakeup_latency.max_ns() >= 4'500'000);
+}
+
 TEST(Controller, OnAVirtualClockOverrunsAreNotCounted) {
   ControllerConfig c = config();
   c.count_overruns = false;
