@@ -171,7 +171,7 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
                         const hal::cy545::Cy545Link& link, const control::MicrosecondHistogram& compute,
                         double simulated_s, std::chrono::steady_clock::time_point wall_start,
                         stencil::sim::SimulatedMill& mill, bool realtime) {
-  const stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
+  stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
   result.cycles = controller.statistics().cycles;
   result.overruns = controller.statistics().overruns;
   result.missed_periods = controller.statistics().missed_periods;
@@ -205,7 +205,7 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
     }
   }
   result.part_heights = machined.part_heights();
-  result.unmachined_heights = machined.unmachined_heights();
+  result.unmachined_heights = std::move(volumes.unmachined_per_cell_mm);
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   mill.set_motion_observer(nullptr);
   return result;
@@ -408,7 +408,16 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       next_update_ns = std::min(next_update_ns, cycle_ns);
       continue;
     }
+    if (job.pace > 0.0 && controller->statistics().cycles % 10 == 0) {
+      // Paced: no further ahead of the wall clock than `pace` simulated seconds per second.
+      const auto due = wall_start + std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+                                        std::chrono::duration<double>(t_s / job.pace));
+      std::this_thread::sleep_until(due);
+    }
     if (controller->statistics().cycles % 1000 == 0) {
+      if (job.interrupted != nullptr && job.interrupted->load()) {
+        static_cast<void>(commands->push({control::CommandKind::Stop}));  // taken by the next cycle
+      }
       const double coverage = reachable_coverage(part, controller->touched());
       if (job.progress && t_s >= next_progress_s) {
         job.progress(t_s, coverage);

@@ -46,6 +46,9 @@ struct SimJob {
   std::FILE* trace = nullptr;   // the mill's true path corners, t_s,x_mm,y_mm,z_mm
   std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
   const std::atomic<bool>* interrupted = nullptr;  // set by SIGINT/SIGTERM: a stop command to the cycle
+  // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
+  // so a person can watch a deterministic run.
+  double pace = 0.0;
 };
 
 // Runs cycle(now_ns, deadline_ns) once per period (on a real-time thread, where the host allows)

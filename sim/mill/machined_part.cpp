@@ -234,35 +234,23 @@ std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& p
   return reachable;
 }
 
-std::vector<double> MachinedPart::unmachined_heights() const {
-  const std::vector<double> reachable = reachable_heights(part_heights());
-  const double floor = stock_.box().low_mm.z();
-  const double top = stock_.box().high_mm.z();
-  std::vector<double> left(reachable.size(), 0.0);
-  for (int row = 0; row < stock_.rows(); ++row) {
-    for (int column = 0; column < stock_.columns(); ++column) {
-      const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) + static_cast<std::size_t>(column);
-      if (reachable[i] < top) {
-        left[i] = std::max(0.0, stock_.height(column, row) - std::max(reachable[i], floor));
-      }
-    }
-  }
-  return left;
-}
-
 MachinedPart::Volumes MachinedPart::volumes() const {
   const std::vector<double> part = part_heights();
   const std::vector<double> reachable = reachable_heights(part);
-  const std::vector<double> left = unmachined_heights();
   const double cell = stock_.cell_mm();
+  const double floor = stock_.box().low_mm.z();
   const double top = stock_.box().high_mm.z();
-  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0};
+  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0, std::vector<double>(reachable.size(), 0.0)};
   for (int row = 0; row < stock_.rows(); ++row) {
     for (int column = 0; column < stock_.columns(); ++column) {
       const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) + static_cast<std::size_t>(column);
+      const double left = stock_.height(column, row);
+      if (reachable[i] < top) {
+        v.unmachined_per_cell_mm[i] = std::max(0.0, left - std::max(reachable[i], floor));
+      }
       v.reachable_mm3 += std::max(0.0, top - reachable[i]);
-      v.unmachined_mm3 += left[i];
-      v.gouge_mm3 += std::max(0.0, part[i] - stock_.height(column, row));
+      v.unmachined_mm3 += v.unmachined_per_cell_mm[i];
+      v.gouge_mm3 += std::max(0.0, part[i] - left);
     }
   }
   v.reachable_mm3 *= cell * cell;

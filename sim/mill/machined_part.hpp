@@ -68,11 +68,10 @@ class MachinedPart final : public MillMotionObserver {
     double gouge_mm3;         // stock cut below the part's top surface
     double unmachined_mm3;    // stock this tool could have removed, still there
     double reachable_mm3;     // all the stock this tool could have removed
+    std::vector<double> unmachined_per_cell_mm;  // over each cell, how thick what is left there is
   };
   [[nodiscard]] Volumes volumes() const;
   [[nodiscard]] std::vector<double> part_heights() const;
-  // Over each cell, the stock still there that this tool could have removed (mm thick), row-major.
-  [[nodiscard]] std::vector<double> unmachined_heights() const;
   [[nodiscard]] const ToolProfile& tool() const { return tool_; }
 
  private:

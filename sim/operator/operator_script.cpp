@@ -46,35 +46,71 @@ void add_finishing_pass(OperatorScript& script, const StockBox& stock, double pr
   if (!blocked(centre.x(), centre.y())) {
     return;  // not star-shaped about its middle: no way round found this way
   }
-  std::vector<Eigen::Vector2d> ring;
-  Eigen::Vector2d approach = centre;
+  // Each direction's wall: the last blocked point before the open floor. Where the blocked region
+  // runs out of the stock instead there is no wall to finish; the way round breaks into arcs there.
+  struct Direction {
+    Eigen::Vector2d at_wall, pressed, outside;
+    bool wall;
+  };
+  std::vector<Direction> directions;
   const double reach = (high.head<2>() - low.head<2>()).norm();
+  const auto in_stock = [&](const Eigen::Vector2d& p) {
+    return p.x() >= low.x() && p.x() <= high.x() && p.y() >= low.y() && p.y() <= high.y();
+  };
   for (int i = 0; i < kDirections; ++i) {
     const double angle = 2.0 * M_PI * i / kDirections;
     const Eigen::Vector2d u(std::cos(angle), std::sin(angle));
-    // Out from the middle to the last blocked point before the open floor or the stock's edge.
     double edge = 0.0;
+    bool wall = false;
     for (double r = 0.0; r <= reach; r += kMarch) {
       const Eigen::Vector2d p = centre + r * u;
-      if (p.x() < low.x() || p.x() > high.x() || p.y() < low.y() || p.y() > high.y() || !blocked(p.x(), p.y())) {
+      if (!in_stock(p)) {
+        break;
+      }
+      if (!blocked(p.x(), p.y())) {
+        wall = true;
         break;
       }
       edge = r;
     }
-    ring.push_back(centre + std::max(0.0, edge - press) * u);
-    if (i == 0) {
-      approach = centre + (edge + 1.0) * u;  // down to the floor in the open, then in to the wall
+    const Eigen::Vector2d outside = (centre + (edge + 1.0) * u).cwiseMax(low.head<2>()).cwiseMin(high.head<2>());
+    directions.push_back({centre + edge * u, centre + std::max(0.0, edge - press) * u, outside, wall});
+  }
+  // Start just after a break, so no arc is split across the end of the list (any start will do
+  // when the wall goes all the way round).
+  int start = 0;
+  for (int i = 0; i < kDirections; ++i) {
+    if (!directions[static_cast<std::size_t>(i)].wall &&
+        directions[static_cast<std::size_t>((i + 1) % kDirections)].wall) {
+      start = (i + 1) % kDirections;
+      break;
     }
   }
   const double floor = low.z();
   const double above = high.z() + 1.0;
-  approach = approach.cwiseMax(low.head<2>()).cwiseMin(high.head<2>());
-  walk_to(script, {approach.x(), approach.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
-  walk_to(script, {approach.x(), approach.y(), floor}, kRepositionFactor * speed_mm_per_s, scale);
-  for (const Eigen::Vector2d& p : ring) {
-    walk_to(script, {p.x(), p.y(), floor}, speed_mm_per_s, scale);
+  const bool all_round = std::all_of(directions.begin(), directions.end(), [](const Direction& d) { return d.wall; });
+  bool in_arc = false;
+  Eigen::Vector2d last = centre;
+  for (int k = 0; k <= kDirections; ++k) {
+    const Direction& d = directions[static_cast<std::size_t>((start + k) % kDirections)];
+    const bool closing = k == kDirections;
+    if (d.wall && !in_arc && !closing) {
+      // Down to the floor in the open, then in to the wall.
+      walk_to(script, {d.outside.x(), d.outside.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
+      walk_to(script, {d.outside.x(), d.outside.y(), floor}, kRepositionFactor * speed_mm_per_s, scale);
+      in_arc = true;
+    }
+    if (in_arc && d.wall && (!closing || all_round)) {
+      walk_to(script, {d.pressed.x(), d.pressed.y(), floor}, speed_mm_per_s, scale);
+      last = d.outside;
+    }
+    if (in_arc && (!d.wall || closing)) {
+      // Out of the wall and up, clear of the part, before the next arc.
+      walk_to(script, {last.x(), last.y(), floor}, kRepositionFactor * speed_mm_per_s, scale);
+      walk_to(script, {last.x(), last.y(), above}, kRepositionFactor * speed_mm_per_s, scale);
+      in_arc = false;
+    }
   }
-  walk_to(script, {ring.front().x(), ring.front().y(), floor}, speed_mm_per_s, scale);
 }
 
 }  // namespace
