@@ -57,4 +57,6 @@ printf '%-22s %10s %10s %10s\n' cyclictest "$c_p99" "$c_p999" "$c_max"
 printf '%-22s %10s %10s %10s\n' stencil-sim "$s_p99" "$s_p999" "$s_max"
 printf '%-22s %10s %10s %10s\n' "ratio sim/cyclictest" "$(ratio "$s_p99" "$c_p99")" "$(ratio "$s_p999" "$c_p999")" \
   "$(ratio "$s_max" "$c_max")"
+top_level() { grep -E "^  \"$1\": " "$out/sim-report.json" | head -n 1 | sed -E 's/.*: ([0-9]+).*/\1/'; }
+echo "stencil-sim: $(top_level overruns) overruns, $(top_level missed_periods) periods skipped after a late wake-up"
 echo "stencil-sim safe_state: $safe (exit status $sim_status); files in $out/"

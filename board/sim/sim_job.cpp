@@ -165,6 +165,40 @@ std::function<double(double, double)> touch_tip_of(const tables::PartTables& par
 
 namespace {
 
+// Every record the cycle left in its journal ring, to the journal file when there is one; a record
+// that cannot be written asks the cycle to stop (once): the record must lose nothing.
+class JournalDrain {
+ public:
+  JournalDrain(journal::JournalWriter* writer, control::CommandRing& commands) : writer_(writer), commands_(commands) {}
+
+  void drain(control::JournalRing& ring) {
+    control::JournalRecord record{};
+    while (ring.pop(record)) {
+      if (writer_ != nullptr && !failed_ && !writer_->append(record)) {
+        fail();
+      }
+    }
+  }
+
+  void sync_if_due() {
+    const auto now = std::chrono::steady_clock::now().time_since_epoch();
+    if (writer_ != nullptr && !failed_ &&
+        !writer_->sync_if_due(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count())) {
+      fail();
+    }
+  }
+
+ private:
+  void fail() {
+    failed_ = true;
+    static_cast<void>(commands_.push({control::CommandKind::JournalFailed}));
+  }
+
+  journal::JournalWriter* writer_;
+  control::CommandRing& commands_;
+  bool failed_ = false;
+};
+
 // The result of a job from its parts, once they have stopped.
 SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
                         const control::MachineSide& machine, const stencil::sim::MachinedPart& machined,
@@ -247,6 +281,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   auto handoffs = std::make_unique<control::MachineHandoffRing>();
   auto telemetry = std::make_unique<control::TelemetryRing>();
   auto journal = std::make_unique<control::JournalRing>();
+  JournalDrain records{job.journal, *commands};
   // The operator's hand, where the script starts, and the device it holds.
   stencil::sim::OperatorHand hand;
   hand.handle_mm = job.script.position_at(0.0);
@@ -314,9 +349,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     });
     std::thread records_thread([&] {
       while (!stop.load()) {
-        control::JournalRecord record{};
-        while (journal->pop(record)) {
-        }
+        records.drain(*journal);
+        records.sync_if_due();
         control::Telemetry frame{};
         while (telemetry->pop(frame)) {
         }
@@ -361,6 +395,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     stop.store(true);
     machine_thread.join();
     records_thread.join();
+    records.drain(*journal);  // the last records, left after the records thread's last look
     fake_runner.reset();
     if (!ran) {
       result.started = false;
@@ -396,9 +431,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
     controller->finish(cycle_ns, cycle_ns + kPeriodNs);
-    control::JournalRecord record{};
-    while (journal->pop(record)) {
-    }
+    records.drain(*journal);
     control::Telemetry frame{};
     while (telemetry->pop(frame)) {
     }
@@ -415,6 +448,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       std::this_thread::sleep_until(due);
     }
     if (controller->statistics().cycles % 1000 == 0) {
+      records.sync_if_due();
       if (job.interrupted != nullptr && job.interrupted->load()) {
         static_cast<void>(commands->push({control::CommandKind::Stop}));  // taken by the next cycle
       }
@@ -433,6 +467,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       }
     }
   }
+  records.drain(*journal);
   machined.flush();
   return finish_result(result, part, *controller, *machine, machined, link, compute,
                        static_cast<double>(cycle_ns - start_ns) / 1e9, wall_start, mill, false);

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "firmware/control/safe_state.hpp"
+#include "firmware/journal/journal_writer.hpp"
 #include "firmware/tables/part_tables.hpp"
 #include "hal/clock.hpp"
 #include "sim/mill/stock_zmap.hpp"
@@ -46,6 +47,7 @@ struct SimJob {
   std::FILE* trace = nullptr;   // the mill's true path corners, t_s,x_mm,y_mm,z_mm
   std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
   const std::atomic<bool>* interrupted = nullptr;  // set by SIGINT/SIGTERM: a stop command to the cycle
+  journal::JournalWriter* journal = nullptr;  // every cycle's record goes here, when given (opened)
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;
@@ -86,6 +88,9 @@ struct SimResult {
   control::SafeReason safe_state = control::SafeReason::None;
   std::string machine_error;  // the machine link's last error, when it faulted
   bool complete = false;  // until_complete met
+  std::string journal_path;     // empty: no journal
+  std::uint64_t journal_records = 0;
+  std::string journal_error;    // why the journal stopped, when it could not be written
   // The machined stock, the part's top and what is left to cut, for the picture: heights per cell, row-major.
   int columns = 0, rows = 0;
   double cell_mm = 0.0;

@@ -22,6 +22,11 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
       {"cycles", r.cycles},
       {"overruns", r.overruns},
       {"missed_periods", r.missed_periods},
+      {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)
+                                         : nlohmann::json{{"path", r.journal_path},
+                                                          {"cycle_records", r.journal_records},
+                                                          {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
+                                                                                            : nlohmann::json(r.journal_error)}}},
       {"simulated_s", r.simulated_s},
       {"wall_s", r.wall_s},
       {"wakeup_latency_us", quantiles_json(r.wakeup_latency_us)},
@@ -74,6 +79,9 @@ std::string summary(const SimResult& r) {
                   r.wakeup_latency_us.p99, r.wakeup_latency_us.p999, r.wakeup_latency_us.max,
                   static_cast<unsigned long long>(r.overruns), static_cast<unsigned long long>(r.missed_periods));
     out += text;
+  }
+  if (!r.journal_error.empty()) {
+    out += "journal: " + r.journal_error + "\n";
   }
   if (!r.machine_error.empty()) {
     out += "machine: " + r.machine_error + "\n";

@@ -3,7 +3,9 @@
 
 #include <pthread.h>
 #include <sched.h>
+#include <fcntl.h>
 #include <sys/mman.h>
+#include <unistd.h>
 #include <time.h>
 
 #include <cstring>
@@ -33,6 +35,33 @@ __attribute__((noinline)) void prefault_stack() {
 }
 
 }  // namespace
+
+CpuLatencyHold::CpuLatencyHold() {
+  fd_ = ::open("/dev/cpu_dma_latency", O_WRONLY | O_CLOEXEC);
+  if (fd_ >= 0) {
+    const std::int32_t zero = 0;
+    if (::write(fd_, &zero, sizeof zero) != static_cast<ssize_t>(sizeof zero)) {
+      ::close(fd_);
+      fd_ = -1;
+    }
+  }
+}
+
+CpuLatencyHold::~CpuLatencyHold() {
+  if (fd_ >= 0) {
+    ::close(fd_);  // the kernel drops the request with the last open file
+  }
+}
+
+bool keep_off_cpu(int cpu) {
+  cpu_set_t cpus;
+  CPU_ZERO(&cpus);
+  if (sched_getaffinity(0, sizeof cpus, &cpus) != 0 || cpu < 0 || cpu >= CPU_SETSIZE) {
+    return false;
+  }
+  CPU_CLR(static_cast<std::size_t>(cpu), &cpus);
+  return CPU_COUNT(&cpus) > 0 && sched_setaffinity(0, sizeof cpus, &cpus) == 0;
+}
 
 RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
                            const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
@@ -64,6 +93,13 @@ RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs peri
       announce("pinning to CPU " + std::to_string(options.cpu) + " was refused");
     }
     prefault_stack();
+    // Held while the loop runs: the CPUs stay out of deep idle states, whose exit on a wake-up can
+    // take longer than the period (cyclictest holds it too, so the two are measured alike).
+    CpuLatencyHold latency_hold;
+    setup.dma_latency_held = latency_hold.held();
+    if (!setup.dma_latency_held) {
+      announce("/dev/cpu_dma_latency could not be held at 0: the CPUs may sleep deeply between cycles");
+    }
     hal::MonotonicNs deadline = (monotonic_now() / period_ns + 1) * period_ns;
     while (!stop.load(std::memory_order_relaxed)) {
       sleep_until(deadline);

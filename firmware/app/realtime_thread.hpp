@@ -23,8 +23,28 @@ struct RealtimeSetup {
   bool sched_fifo = false;
   bool pinned = false;
   bool memory_locked = false;
+  bool dma_latency_held = false;  // /dev/cpu_dma_latency held at 0 while the loop ran
   std::string refused;  // non-empty: why it did not run (only with require)
 };
+
+// Holds /dev/cpu_dma_latency at 0 (no deep idle states) while it lives; held() says whether the
+// host allowed it.
+class CpuLatencyHold {
+ public:
+  CpuLatencyHold();
+  ~CpuLatencyHold();
+  CpuLatencyHold(const CpuLatencyHold&) = delete;
+  CpuLatencyHold& operator=(const CpuLatencyHold&) = delete;
+  [[nodiscard]] bool held() const { return fd_ >= 0; }
+
+ private:
+  int fd_ = -1;
+};
+
+// Keeps the calling thread, and every thread it starts from now on, off `cpu` (the cycle's), so the
+// cycle's CPU runs the cycle and nothing of ours that sits in the kernel when the cycle should wake.
+// False (and nothing changed) when there is no other CPU or the host refuses.
+bool keep_off_cpu(int cpu);
 
 // Runs `cycle(now_ns, deadline_ns)` once per period on a new thread until it returns false or `stop`
 // is set; each call's deadline is the absolute start of its period. Blocks until the thread ends.

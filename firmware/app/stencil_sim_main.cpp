@@ -1,6 +1,7 @@
 // stencil-sim: the controller's cycle and machine side against the simulated device, the fake CY545
 // on a pseudo-terminal and the simulated mill, on the baked-in sample part or a table file; reports
 // gouges, coverage and loop timing.
+#include <chrono>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -118,6 +119,10 @@ int main(int argc, char** argv) {
   app.add_flag("--until-complete", until_complete,
                "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
   app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the part's box grown by 2 mm)");
+  std::string journal_path;
+  app.add_option("--journal", journal_path,
+                 "record the job here: every cycle's device sample and virtual tool, and every safe-state event, "
+                 "with a CRC-32 each, synced to the disk every second and at once on a safe state (default: none)");
   app.add_option("--trace", trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
   app.add_option("--haptic-transport", transport,
                  "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
@@ -214,10 +219,30 @@ int main(int argc, char** argv) {
   // The outputs can be written: found out now, not after the whole simulated job (every input has
   // been checked by now, so bad input leaves no report behind).
   for (const std::string& path : {report_path, picture_path}) {
+    const bool existed = access(path.c_str(), F_OK) == 0;
     std::ofstream probe(path, std::ios::app);
     if (!probe) {
       return bad_input(path + ": cannot be written");
     }
+    probe.close();
+    if (!existed) {
+      std::remove(path.c_str());  // made only to find out: a refused run leaves nothing behind
+    }
+  }
+  journal::JournalWriter journal_writer;
+  if (!journal_path.empty()) {
+    journal::JournalStart start;
+    start.tables_crc32 = part.header.crc32;
+    start.triangle_count = part.header.triangle_count;
+    start.unix_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
+                             std::chrono::system_clock::now().time_since_epoch())
+                             .count();
+    start.program = "stencil-sim";
+    if (!journal_writer.open(journal_path, start)) {
+      return bad_input(journal_writer.error());
+    }
+    job.journal = &journal_writer;
+    std::printf("journal: %s\n", journal_path.c_str());
   }
   struct sigaction action {};
   action.sa_handler = on_signal;
@@ -230,6 +255,11 @@ int main(int argc, char** argv) {
     result = board::sim::run_fast(job);
   } else {
     const app::RealtimeOptions options{priority, cpu, require_rt};
+    // The machine, fake CY545 and records threads start after this and inherit it: the cycle's
+    // CPU is left to the cycle.
+    if (cpu >= 0 && !app::keep_off_cpu(cpu)) {
+      std::fprintf(stderr, "stencil-sim: the other threads could not be kept off CPU %d; they share it with the cycle\n", cpu);
+    }
     result = board::sim::run_realtime(
         job, [&](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
                  const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle, std::string& refused) {
@@ -249,6 +279,12 @@ int main(int argc, char** argv) {
   if (!result.started) {
     std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
     return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
+  }
+  if (journal_writer.is_open() || !journal_writer.error().empty()) {
+    const bool closed = journal_writer.close();
+    result.journal_path = journal_path;
+    result.journal_records = journal_writer.cycle_records();
+    result.journal_error = closed ? "" : journal_writer.error();
   }
   std::printf("%s", board::sim::summary(result).c_str());
   if (!board::sim::write_report_json(report_path, result, error) ||

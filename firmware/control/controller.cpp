@@ -80,6 +80,9 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       case CommandKind::Stop:
         enter_safe_state(SafeReason::Stopped);
         break;
+      case CommandKind::JournalFailed:
+        enter_safe_state(SafeReason::JournalFailed);
+        break;
       case CommandKind::Reset:
         last_reset_ = try_reset(now_ns);
         ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);

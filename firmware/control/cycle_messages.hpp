@@ -13,6 +13,7 @@ namespace stencil::control {
 enum class CommandKind : std::uint8_t {
   Reset,  // leave the safe state (accepted only while the device is held still near the virtual tool)
   Stop,   // enter it (SIGINT/SIGTERM, the terminal, the display)
+  JournalFailed,  // enter it: the journal writer could not write the record (the cut must stop)
 };
 
 struct Command {

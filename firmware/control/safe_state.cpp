@@ -23,6 +23,8 @@ const char* safe_reason_name(SafeReason reason) {
       return "overrun_storm";
     case SafeReason::JournalFull:
       return "journal_full";
+    case SafeReason::JournalFailed:
+      return "journal_failed";
     case SafeReason::EngineFault:
       return "engine_fault";
     case SafeReason::Stopped:

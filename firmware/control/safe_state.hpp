@@ -15,6 +15,7 @@ enum class SafeReason : std::uint8_t {
   MachineFault,        // the machine side reported a fault, or fell behind the cycle
   OverrunStorm,        // more consecutive overruns than allowed
   JournalFull,         // the journal ring was full: the record would lose a sample
+  JournalFailed,       // the journal file could not be written (disk full, I/O error)
   EngineFault,         // the engine refused its inputs or found the tables damaged
   Stopped,             // a stop command (SIGINT/SIGTERM, the terminal, the display)
 };

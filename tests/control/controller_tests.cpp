@@ -314,6 +314,15 @@ TEST(Controller, AStopCommandEntersTheSafeState) {
   check_safe(bench, SafeReason::Stopped);
 }
 
+TEST(Controller, AJournalThatCannotBeWrittenEntersTheSafeStateWithItsOwnReason) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.commands.push({CommandKind::JournalFailed}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::JournalFailed);
+  STRCMP_EQUAL("journal_failed", stencil::control::safe_reason_name(bench.controller->safe_reason()));
+}
+
 TEST(Controller, TheSafeStateLatchesWhenItsCauseIsGone) {
   Bench bench;
   bench.cycles(20);

@@ -173,6 +173,25 @@ case_speed_n_is_fast_mode_paced() {
   awk -v w="$wall" 'BEGIN { exit !(w + 0 >= 0.6) }' || fail "12 simulated s at --speed 20 took $wall s; expected at least 0.6 s"
 }
 
+# --journal: every cycle's record reaches the file (12 header bytes, the 38-byte start record naming
+# stencil-sim, 95 bytes a cycle); a journal that cannot be created is refused before the run.
+case_journal_holds_every_cycle() {
+  run_sim --fast --pattern plunge --duration 5 --journal job.journal --report report.json
+  expect_status 0
+  grep -q '"cycle_records"' report.json || fail "the report does not describe the journal"
+  local cycles records size
+  cycles=$(json_number report.json cycles)
+  records=$(json_number report.json cycle_records)
+  [ "$records" = "$cycles" ] || fail "the journal holds $records cycle records; the run had $cycles cycles"
+  size=$(stat -c %s job.journal)
+  [ "$size" -eq $((12 + 38 + 95 * cycles)) ] || fail "job.journal is $size bytes; expected $((12 + 38 + 95 * cycles))"
+  head -c 8 job.journal | grep -q STENCILJ || fail "job.journal does not start with the magic STENCILJ"
+  run_sim --fast --pattern plunge --duration 5 --journal /nonexistent/job.journal --report report2.json
+  expect_status 2
+  expect_stderr "/nonexistent/job.journal: cannot be created: No such file or directory" "which journal and why"
+  [ ! -e report2.json ] || fail "a refused run left a report behind"
+}
+
 case_refuses_a_bad_operator_csv() {
   printf 't_s,x_mm,y_mm,z_mm\n0,250,125,200\n0.5,250,abc,200\n' >operator.csv
   run_sim --fast --operator operator.csv --report report.json

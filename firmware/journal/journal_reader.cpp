@@ -1,0 +1,155 @@
+// The journal reader: the header, then record by record until the bytes or the whole records end.
+#include "firmware/journal/journal_reader.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <vector>
+
+#include <zlib.h>
+
+#include "firmware/control/safe_state.hpp"
+#include "firmware/journal/journal_bytes.hpp"
+
+namespace stencil::journal {
+namespace {
+
+bool valid_reason(std::uint8_t value) { return value <= static_cast<std::uint8_t>(control::SafeReason::Stopped); }
+
+std::string at(std::size_t offset) { return "journal offset " + std::to_string(offset) + ": "; }
+
+}  // namespace
+
+JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const JournalVisitor& visit) {
+  JournalReadResult result;
+  ByteReader header(data, size);
+  if (size < kFileHeaderBytes || std::memcmp(data, kMagic, sizeof kMagic) != 0) {
+    result.error = at(0) + "not a journal (expected the magic STENCILJ and a version: " + std::to_string(kFileHeaderBytes) +
+                   " bytes)";
+    return result;
+  }
+  header.skip(sizeof kMagic);
+  const std::uint32_t version = header.u32();
+  if (version != kVersion) {
+    result.error = at(8) + "version " + std::to_string(version) + "; this program reads version " + std::to_string(kVersion);
+    return result;
+  }
+  std::size_t offset = kFileHeaderBytes;
+  while (offset < size) {
+    const std::size_t left = size - offset;
+    ByteReader head(data + offset, left);
+    const std::uint32_t length = head.u32();
+    const auto type = static_cast<RecordType>(head.u8());
+    if (head.overrun() || length > kMaxPayloadBytes || left < kRecordOverheadBytes + length) {
+      result.tail = at(offset) + (head.overrun() || length <= kMaxPayloadBytes
+                                      ? "a record cut short"
+                                      : "a record length of " + std::to_string(length) + " (at most " +
+                                            std::to_string(kMaxPayloadBytes) + ")");
+      break;
+    }
+    const std::uint8_t* payload = data + offset + 5;
+    uLong crc = crc32(0L, Z_NULL, 0);
+    crc = crc32(crc, data + offset, static_cast<uInt>(5 + length));
+    ByteReader tail(payload + length, 4);
+    if (tail.u32() != static_cast<std::uint32_t>(crc)) {
+      result.tail = at(offset) + "a record whose CRC-32 does not match";
+      break;
+    }
+    ByteReader body(payload, length);
+    switch (type) {
+      case RecordType::Start: {
+        JournalStart start;
+        start.tables_crc32 = body.u32();
+        start.triangle_count = body.u32();
+        start.unix_time_ns = body.i64();
+        const std::uint16_t name = body.u16();
+        if (body.overrun() || body.left() != name) {
+          result.error = at(offset) + "a start record of " + std::to_string(length) + " bytes that does not hold its program name";
+          return result;
+        }
+        start.program.assign(reinterpret_cast<const char*>(body.here()), name);
+        if (visit.start) {
+          visit.start(start);
+        }
+        break;
+      }
+      case RecordType::Cycle: {
+        if (length != kCyclePayloadBytes) {
+          result.error = at(offset) + "a cycle record of " + std::to_string(length) + " bytes (expected " +
+                         std::to_string(kCyclePayloadBytes) + ")";
+          return result;
+        }
+        control::JournalRecord r{};
+        r.cycle = body.u64();
+        r.time_ns = body.i64();
+        for (double& v : r.device_mm) {
+          v = body.f64();
+        }
+        for (double& v : r.angles_rad) {
+          v = body.f64();
+        }
+        r.sample_counter = body.u32();
+        const std::uint8_t fresh = body.u8();
+        for (double& v : r.virtual_tip_mm) {
+          v = body.f64();
+        }
+        const std::uint8_t reason = body.u8();
+        if (fresh > 1 || !valid_reason(reason)) {
+          result.error = at(offset) + (fresh > 1 ? "a cycle record's fresh flag is " + std::to_string(fresh) + " (expected 0 or 1)"
+                                                 : "a cycle record's safe reason is " + std::to_string(reason) + " (no such reason)");
+          return result;
+        }
+        r.fresh = fresh == 1;
+        r.safe_reason = static_cast<control::SafeReason>(reason);
+        if (visit.cycle) {
+          visit.cycle(r);
+        }
+        break;
+      }
+      case RecordType::SafeState: {
+        if (length != kSafeStatePayloadBytes) {
+          result.error = at(offset) + "a safe-state record of " + std::to_string(length) + " bytes (expected " +
+                         std::to_string(kSafeStatePayloadBytes) + ")";
+          return result;
+        }
+        const std::uint64_t cycle = body.u64();
+        const std::uint8_t reason = body.u8();
+        if (!valid_reason(reason) || reason == 0) {
+          result.error = at(offset) + "a safe-state record's reason is " + std::to_string(reason) + " (no such reason)";
+          return result;
+        }
+        if (visit.safe_state) {
+          visit.safe_state(cycle, static_cast<control::SafeReason>(reason));
+        }
+        break;
+      }
+      default:
+        result.error = at(offset) + "a record of type " + std::to_string(static_cast<int>(type)) +
+                       " (expected 1 start, 2 cycle or 3 safe state)";
+        return result;
+    }
+    ++result.records;
+    offset += kRecordOverheadBytes + length;
+  }
+  result.good_bytes = offset;
+  result.tail_bytes = size - offset;
+  result.ok = true;
+  return result;
+}
+
+JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    JournalReadResult result;
+    result.error = path + ": cannot be read";
+    return result;
+  }
+  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  JournalReadResult result = read_journal(bytes.data(), bytes.size(), visit);
+  if (!result.error.empty()) {
+    result.error = path + ": " + result.error;
+  }
+  return result;
+}
+
+}  // namespace stencil::journal

@@ -1,0 +1,233 @@
+// The journal: what is written reads back exactly; a torn tail at any byte is found and ignored,
+// never misread; damage that is not a crash's is an error naming the offset; a full disk is a clear
+// failure.
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include "firmware/journal/journal_format.hpp"
+#include "firmware/journal/journal_reader.hpp"
+#include "firmware/journal/journal_writer.hpp"
+
+#include <CppUTest/TestHarness.h>
+
+using stencil::control::JournalRecord;
+using stencil::control::SafeReason;
+using namespace stencil::journal;
+
+namespace {
+
+JournalRecord record_of(std::uint64_t cycle, SafeReason reason = SafeReason::None) {
+  JournalRecord r{};
+  r.cycle = cycle;
+  r.time_ns = static_cast<std::int64_t>(cycle) * 1'000'000 + 17;
+  r.device_mm[0] = 250.0 + 1e-3 * static_cast<double>(cycle);
+  r.device_mm[1] = 125.123456789012345;
+  r.device_mm[2] = -3.0;
+  r.angles_rad[0] = 0.1;
+  r.angles_rad[1] = -0.2;
+  r.sample_counter = static_cast<std::uint32_t>(cycle * 3);
+  r.fresh = cycle % 2 == 0;
+  r.virtual_tip_mm[0] = 25.0;
+  r.virtual_tip_mm[1] = 12.5 + 1e-9 * static_cast<double>(cycle);
+  r.virtual_tip_mm[2] = 7.25;
+  r.safe_reason = reason;
+  return r;
+}
+
+struct TempJournal {
+  std::string path;
+  TempJournal() {
+    char name[] = "/tmp/journal_tests_XXXXXX";
+    const int fd = mkstemp(name);
+    if (fd >= 0) {
+      close(fd);
+    }
+    path = name;
+  }
+  ~TempJournal() { std::remove(path.c_str()); }
+  [[nodiscard]] std::vector<std::uint8_t> bytes() const {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+};
+
+JournalStart start_of() {
+  JournalStart start;
+  start.tables_crc32 = 0xdeadbeef;
+  start.triangle_count = 92;
+  start.unix_time_ns = 1'796'000'000'000'000'000;
+  start.program = "journal_tests";
+  return start;
+}
+
+// Writes `cycles` records (the last `safe_from` onward in the safe state) and closes.
+void write_job(const std::string& path, int cycles, int safe_from = -1) {
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(path, start_of()));
+  for (int i = 0; i < cycles; ++i) {
+    const SafeReason reason = safe_from >= 0 && i >= safe_from ? SafeReason::PoseJump : SafeReason::None;
+    CHECK_TRUE(writer.append(record_of(static_cast<std::uint64_t>(i), reason)));
+  }
+  CHECK_TRUE(writer.close());
+}
+
+struct Seen {
+  int starts = 0;
+  std::vector<JournalRecord> cycles;
+  std::vector<std::pair<std::uint64_t, SafeReason>> events;
+  JournalStart start;
+  JournalVisitor visitor() {
+    return {[this](const JournalStart& s) {
+              ++starts;
+              start = s;
+            },
+            [this](const JournalRecord& r) { cycles.push_back(r); },
+            [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); }};
+  }
+};
+
+void check_same(const JournalRecord& a, const JournalRecord& b) {
+  LONGS_EQUAL(a.cycle, b.cycle);
+  LONGS_EQUAL(a.time_ns, b.time_ns);
+  for (int i = 0; i < 3; ++i) {
+    CHECK(a.device_mm[i] == b.device_mm[i]);  // bit for bit: a replay must be exact
+    CHECK(a.virtual_tip_mm[i] == b.virtual_tip_mm[i]);
+  }
+  CHECK(a.angles_rad[0] == b.angles_rad[0] && a.angles_rad[1] == b.angles_rad[1]);
+  LONGS_EQUAL(a.sample_counter, b.sample_counter);
+  CHECK(a.fresh == b.fresh);
+  CHECK(a.safe_reason == b.safe_reason);
+}
+
+}  // namespace
+
+TEST_GROUP(Journal){};
+
+TEST(Journal, WhatIsWrittenReadsBackExactlyWithTheStartAndTheSafeStateEvent) {
+  TempJournal file;
+  write_job(file.path, 300, 250);
+  Seen seen;
+  const JournalReadResult read = read_journal_file(file.path, seen.visitor());
+  CHECK_TRUE(read.ok);
+  LONGS_EQUAL(0, read.tail_bytes);
+  LONGS_EQUAL(1, seen.starts);
+  LONGS_EQUAL(0xdeadbeef, seen.start.tables_crc32);
+  LONGS_EQUAL(92, seen.start.triangle_count);
+  CHECK(seen.start.unix_time_ns == start_of().unix_time_ns);
+  STRCMP_EQUAL("journal_tests", seen.start.program.c_str());
+  LONGS_EQUAL(300, seen.cycles.size());
+  for (int i = 0; i < 300; ++i) {
+    check_same(record_of(static_cast<std::uint64_t>(i), i >= 250 ? SafeReason::PoseJump : SafeReason::None),
+               seen.cycles[static_cast<std::size_t>(i)]);
+  }
+  LONGS_EQUAL(1, seen.events.size());  // one event, not one per cycle in the safe state
+  LONGS_EQUAL(250, seen.events[0].first);
+  CHECK(seen.events[0].second == SafeReason::PoseJump);
+  LONGS_EQUAL(1 + 300 + 1, read.records);
+}
+
+TEST(Journal, TheSafeStateEventIsOnTheDiskTheMomentItIsAppended) {
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  for (int i = 0; i < 10; ++i) {
+    CHECK_TRUE(writer.append(record_of(static_cast<std::uint64_t>(i))));
+  }
+  const std::uint64_t syncs = writer.syncs();
+  CHECK_TRUE(writer.append(record_of(10, SafeReason::DeviceStale)));
+  LONGS_EQUAL(syncs + 1, writer.syncs());
+  // Read while the writer is still open, as after a crash right here.
+  Seen seen;
+  const std::vector<std::uint8_t> bytes = file.bytes();
+  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
+  CHECK_TRUE(read.ok);
+  LONGS_EQUAL(11, seen.cycles.size());
+  LONGS_EQUAL(1, seen.events.size());
+  CHECK(seen.events[0].second == SafeReason::DeviceStale);
+}
+
+TEST(Journal, SyncsWhenASecondHasPassedAndNotBefore) {
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  const std::uint64_t after_open = writer.syncs();
+  CHECK_TRUE(writer.append(record_of(0)));
+  CHECK_TRUE(writer.sync_if_due(5'000'000'000));  // the first look syncs
+  LONGS_EQUAL(after_open + 1, writer.syncs());
+  CHECK_TRUE(writer.sync_if_due(5'900'000'000));
+  LONGS_EQUAL(after_open + 1, writer.syncs());
+  CHECK_TRUE(writer.sync_if_due(6'000'000'000));
+  LONGS_EQUAL(after_open + 2, writer.syncs());
+}
+
+// A crash can cut the file anywhere: every cut inside the last record reads every record before it
+// and reports the rest as the tail; none is misread.
+TEST(Journal, ATornTailAtAnyByteIsIgnoredAndEverythingBeforeItReads) {
+  TempJournal file;
+  write_job(file.path, 5);
+  const std::vector<std::uint8_t> whole = file.bytes();
+  const std::size_t last = kRecordOverheadBytes + kCyclePayloadBytes;
+  for (std::size_t cut = 1; cut < last; ++cut) {
+    Seen seen;
+    const JournalReadResult read = read_journal(whole.data(), whole.size() - cut, seen.visitor());
+    CHECK_TRUE(read.ok);
+    LONGS_EQUAL(4, seen.cycles.size());
+    LONGS_EQUAL(last - cut, read.tail_bytes);
+    CHECK_FALSE(read.tail.empty());
+    check_same(record_of(3), seen.cycles.back());
+  }
+}
+
+TEST(Journal, AFlippedBitEndsTheReadAtThatRecordAndSaysWhere) {
+  TempJournal file;
+  write_job(file.path, 5);
+  std::vector<std::uint8_t> bytes = file.bytes();
+  const std::size_t start_record = kRecordOverheadBytes + 2 + 4 + 4 + 8 + std::string("journal_tests").size();
+  const std::size_t third = kFileHeaderBytes + start_record + 2 * (kRecordOverheadBytes + kCyclePayloadBytes);
+  bytes[third + 20] ^= 0x10;  // inside the third cycle record's payload
+  Seen seen;
+  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
+  CHECK_TRUE(read.ok);
+  LONGS_EQUAL(2, seen.cycles.size());
+  LONGS_EQUAL(third, read.good_bytes);
+  STRCMP_CONTAINS(("journal offset " + std::to_string(third) + ": a record whose CRC-32 does not match").c_str(),
+                  read.tail.c_str());
+}
+
+TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
+  const std::uint8_t text[] = "t_s,x_mm,y_mm,z_mm\n";
+  Seen seen;
+  JournalReadResult read = read_journal(text, sizeof text, seen.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("not a journal (expected the magic STENCILJ", read.error.c_str());
+  TempJournal file;
+  write_job(file.path, 1);
+  std::vector<std::uint8_t> bytes = file.bytes();
+  bytes[8] = 9;
+  read = read_journal(bytes.data(), bytes.size(), seen.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("journal offset 8: version 9; this program reads version 1", read.error.c_str());
+  read = read_journal_file("/nonexistent/journal", seen.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());
+}
+
+TEST(Journal, AFullDiskIsAFailureThatSaysSo) {
+  JournalWriter writer;
+  // /dev/full takes the open and refuses every write with ENOSPC.
+  CHECK_FALSE(writer.open("/dev/full", start_of()));
+  STRCMP_CONTAINS("/dev/full: write failed: No space left on device", writer.error().c_str());
+  CHECK_FALSE(writer.append(record_of(0)));  // nothing after a failure
+}
+
+TEST(Journal, AFileThatCannotBeCreatedIsAFailureNamingIt) {
+  JournalWriter writer;
+  CHECK_FALSE(writer.open("/nonexistent/dir/job.journal", start_of()));
+  STRCMP_EQUAL("/nonexistent/dir/job.journal: cannot be created: No such file or directory", writer.error().c_str());
+}
