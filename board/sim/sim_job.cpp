@@ -41,6 +41,7 @@ namespace {
 constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
 constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
 constexpr double kBaud = 57600.0;
+constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
 
 motion::MachineFrames sim_frames() {
   // Every axis counts into the workspace from its switch, so the world runs against all three.
@@ -201,7 +202,8 @@ class JournalDrain {
 
 // The result of a job from its parts, once they have stopped.
 SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
-                        const control::MachineSide& machine, const stencil::sim::MachinedPart& machined,
+                        const control::MachineSide& machine, const control::CommandedStock& model,
+                        const stencil::sim::MachinedPart& machined,
                         const hal::cy545::Cy545Link& link, const control::MicrosecondHistogram& compute,
                         double simulated_s, std::chrono::steady_clock::time_point wall_start,
                         stencil::sim::SimulatedMill& mill, bool realtime) {
@@ -240,6 +242,18 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
   }
   result.part_heights = machined.part_heights();
   result.unmachined_heights = std::move(volumes.unmachined_per_cell_mm);
+  // The controller's model beside the ground truth: each model cell against the mill's cell under
+  // its centre.
+  result.model_removed_volume_mm3 = model.removed_volume_mm3();
+  for (int row = 0; row < model.rows(); ++row) {
+    for (int column = 0; column < model.columns(); ++column) {
+      const double x = model.block().low_mm.x() + (column + 0.5) * model.cell_mm();
+      const double y = model.block().low_mm.y() + (row + 0.5) * model.cell_mm();
+      const int c = std::clamp(static_cast<int>((x - stock.box().low_mm.x()) / stock.cell_mm()), 0, stock.columns() - 1);
+      const int r = std::clamp(static_cast<int>((y - stock.box().low_mm.y()) / stock.cell_mm()), 0, stock.rows() - 1);
+      result.model_max_difference_mm = std::max(result.model_max_difference_mm, std::abs(model.height(column, row) - stock.height(c, r)));
+    }
+  }
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   mill.set_motion_observer(nullptr);
   return result;
@@ -308,6 +322,11 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   }
   const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
   auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, *handoffs, *machine_events);
+  // The controller's own model of the stock, from the targets it sends (cells allocated here, once).
+  const control::StockBlock block{job.stock.low_mm, job.stock.high_mm};
+  std::vector<float> model_cells(control::CommandedStock::cells_needed(block, kModelCellMm));
+  control::CommandedStock model(block, kModelCellMm, part.tool.spec, model_cells);
+  machine->keep_stock_model(&model);
   // In real time the fake CY545 answers from a thread of its own; on virtual time it follows the
   // machine side's clock.
   std::unique_ptr<stencil::sim::cy545::FakeCy545Runner> fake_runner;
@@ -403,7 +422,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       return result;
     }
     machined.flush();
-    return finish_result(result, part, *controller, *machine, machined, link, controller->statistics().compute,
+    return finish_result(result, part, *controller, *machine, model, machined, link, controller->statistics().compute,
                          static_cast<double>(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() - start_ns) / 1e9,
                          wall_start, mill, true);
   }
@@ -469,7 +488,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   }
   records.drain(*journal);
   machined.flush();
-  return finish_result(result, part, *controller, *machine, machined, link, compute,
+  return finish_result(result, part, *controller, *machine, model, machined, link, compute,
                        static_cast<double>(cycle_ns - start_ns) / 1e9, wall_start, mill, false);
 }
 

@@ -88,6 +88,8 @@ struct SimResult {
   control::SafeReason safe_state = control::SafeReason::None;
   std::string machine_error;  // the machine link's last error, when it faulted
   bool complete = false;  // until_complete met
+  double model_removed_volume_mm3 = 0.0;  // the controller's own model of the stock (what it commanded)
+  double model_max_difference_mm = 0.0;   // the most it differs from the mill's stock over any cell
   std::string journal_path;     // empty: no journal
   std::uint64_t journal_records = 0;
   std::string journal_error;    // why the journal stopped, when it could not be written

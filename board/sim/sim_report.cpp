@@ -22,6 +22,8 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
       {"cycles", r.cycles},
       {"overruns", r.overruns},
       {"missed_periods", r.missed_periods},
+      {"stock_model",
+       {{"removed_volume_mm3", r.model_removed_volume_mm3}, {"max_difference_mm", r.model_max_difference_mm}}},
       {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)
                                          : nlohmann::json{{"path", r.journal_path},
                                                           {"cycle_records", r.journal_records},

@@ -7,7 +7,8 @@ namespace stencil::control {
 
 MachineSide::MachineSide(const tables::PartTables& part, hal::MachineLink& link, const motion::MachineFrames& frames, const motion::PlannerLimits& limits,
                          MachineHandoffRing& from_cycle, MachineEventRing& to_cycle)
-    : link_(link), from_cycle_(from_cycle), to_cycle_(to_cycle), planner_(part, frames, limits) {}
+    : link_(link), from_cycle_(from_cycle), to_cycle_(to_cycle), planner_(part, frames, limits),
+      commanded_tip_mm_(frames.home_world_mm) {}
 
 bool MachineSide::start(hal::MonotonicNs deadline_ns) {
   if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
@@ -73,6 +74,19 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
       }
       ++statistics_.updates;
       statistics_.take_ups += plan.status == motion::PlanStatus::TakingUp ? 1 : 0;
+      // The tool goes there one axis at a time, in the plan's order: each leg cuts the model.
+      for (const std::uint8_t axis : plan.order) {
+        if (axis > 2) {
+          continue;
+        }
+        Eigen::Vector3d next = commanded_tip_mm_;
+        next[axis] = plan.target_mm[axis];
+        if (stock_ != nullptr && next != commanded_tip_mm_) {
+          stock_->cut(commanded_tip_mm_, next);
+        }
+        commanded_tip_mm_ = next;
+      }
+      commanded_tip_mm_ = plan.target_mm;
       statistics_.motor_steps += plan.motor_steps;
       break;
     }

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 
+#include "firmware/control/commanded_stock.hpp"
 #include "firmware/control/cycle_messages.hpp"
 #include "firmware/motion/machine_planner.hpp"
 #include "hal/clock.hpp"  // MonotonicNs
@@ -49,6 +50,13 @@ class MachineSide {
   [[nodiscard]] bool at_goal() const { return at_goal_; }
   [[nodiscard]] const motion::MachinePlanner& planner() const { return planner_; }
 
+  // The model of the machined stock this side keeps from the targets it sends (null: none). Set
+  // before start(); this side is its only writer, readers look once the machine thread is done or
+  // between updates on the same thread.
+  void keep_stock_model(CommandedStock* stock) { stock_ = stock; }
+  // Where the last target sent puts the tool tip (world mm): home until the first.
+  [[nodiscard]] const Eigen::Vector3d& commanded_tip_mm() const { return commanded_tip_mm_; }
+
  private:
   void stop(hal::MonotonicNs deadline_ns, bool report_fault);
 
@@ -60,6 +68,8 @@ class MachineSide {
   std::uint64_t moves_seen_ = 0;
   bool at_goal_ = false;
   MachineSideStatistics statistics_;
+  CommandedStock* stock_ = nullptr;
+  Eigen::Vector3d commanded_tip_mm_;
 };
 
 }  // namespace stencil::control

@@ -78,6 +78,8 @@ case_raster_corner() {
   expect_status 0
   no_gouge
   at_most "$(json_number report.json fraction)" 0.01 "the unmachined fraction"
+  # The controller's own model of the stock (from what it commanded) agrees with the mill's.
+  at_most "$(json_number report.json max_difference_mm)" 0.01 "the model's largest difference from the mill's stock (mm)"
   [ -s report.svg ] || fail "no picture was written beside the report"
   grep -q '<svg' report.svg || fail "report.svg is not an SVG picture"
 }
