@@ -18,6 +18,7 @@
 #include "firmware/control/controller.hpp"
 #include "firmware/control/loop_statistics.hpp"
 #include "firmware/control/machine_side.hpp"
+#include "firmware/journal/journal_drain.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
@@ -166,40 +167,6 @@ std::function<double(double, double)> touch_tip_of(const tables::PartTables& par
 
 namespace {
 
-// Every record the cycle left in its journal ring, to the journal file when there is one; a record
-// that cannot be written asks the cycle to stop (once): the record must lose nothing.
-class JournalDrain {
- public:
-  JournalDrain(journal::JournalWriter* writer, control::CommandRing& commands) : writer_(writer), commands_(commands) {}
-
-  void drain(control::JournalRing& ring) {
-    control::JournalRecord record{};
-    while (ring.pop(record)) {
-      if (writer_ != nullptr && !failed_ && !writer_->append(record)) {
-        fail();
-      }
-    }
-  }
-
-  void sync_if_due() {
-    const auto now = std::chrono::steady_clock::now().time_since_epoch();
-    if (writer_ != nullptr && !failed_ &&
-        !writer_->sync_if_due(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count())) {
-      fail();
-    }
-  }
-
- private:
-  void fail() {
-    failed_ = true;
-    static_cast<void>(commands_.push({control::CommandKind::JournalFailed}));
-  }
-
-  journal::JournalWriter* writer_;
-  control::CommandRing& commands_;
-  bool failed_ = false;
-};
-
 // The result of a job from its parts, once they have stopped.
 SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
                         const control::MachineSide& machine, const control::CommandedStock& model,
@@ -295,7 +262,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   auto handoffs = std::make_unique<control::MachineHandoffRing>();
   auto telemetry = std::make_unique<control::TelemetryRing>();
   auto journal = std::make_unique<control::JournalRing>();
-  JournalDrain records{job.journal, *commands};
+  journal::JournalDrain records{job.journal, *commands};
   // The operator's hand, where the script starts, and the device it holds.
   stencil::sim::OperatorHand hand;
   hand.handle_mm = job.script.position_at(0.0);

@@ -1,16 +1,34 @@
 // stencil-rig: the controller on the real rig (board sherline_suzuki): the haptic device over the
 // PIO shared-memory card or SocketCAN, the mill's CY545 over RS-232. It starts by checking
 // everything it can (the host's real-time readiness, the tables, the serial port, the haptic link)
-// and says plainly what is missing.
+// and says plainly what is missing, then homes the mill and runs the cycle until SIGINT/SIGTERM,
+// --duration or a safe state, and stops the machine on the way out.
+#include <signal.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <string>
 #include <vector>
+#include <cmath>
+#include <memory>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
 
+#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_job.hpp"
+#include "firmware/app/realtime_thread.hpp"
 #include "firmware/app/rt_readiness.hpp"
+#include "firmware/journal/journal_writer.hpp"
+#include "hal/cy545/cy545_link.hpp"
+#include "hal/pio_shared_memory/pio_haptic_device.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
+#include "hal/socketcan/socketcan_haptic_device.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/pio_shared_memory/shared_window_mapping.hpp"
@@ -29,14 +47,36 @@ int fail(int status, const std::string& message) {
   return status;
 }
 
+std::atomic<bool> interrupted{false};
+void on_signal(int) { interrupted.store(true); }
+
+// "X,Y,Z" (or six numbers for a block) as finite numbers, all of each field: false otherwise.
+bool parse_numbers(const std::string& text, std::vector<double>& out, std::size_t count) {
+  out.clear();
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string field = text.substr(at, comma - at);
+    char* end = nullptr;
+    const double value = std::strtod(field.c_str(), &end);
+    if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(value)) {
+      return false;
+    }
+    out.push_back(value);
+    at = comma + 1;
+  }
+  return out.size() == count;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{
       "stencil-rig: the haptic stencil controller on the Sherline + Suzuki rig. Checks the host's real-time\n"
       "readiness, loads the tables, opens the CY545's serial port and the haptic device's link, and says what\n"
-      "is missing. The real-time run loop on the rig is not built yet: with everything present it says so and\n"
-      "stops (use stencil-sim for the simulated rig). Exit status: 2 bad input, 3 could not start."};
+      "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM, --duration or a safe\n"
+      "state, and holds and stops the mill on the way out. A safe state ends the run (no resume yet).\n"
+      "Exit status: 0 stopped as asked, 2 bad input, 3 could not start or ended in a safe state."};
   std::string tables_path;
   std::string serial_path;
   std::string haptic;
@@ -47,10 +87,59 @@ int main(int argc, char** argv) {
   app.add_option("--haptic", haptic, "the haptic link: pio:/dev/uioN or can:IFACE")->required();
   app.add_flag("--require-rt", require_rt, "refuse to run without PREEMPT_RT and SCHED_FIFO");
   app.add_option("--priority", priority, "the cycle thread's SCHED_FIFO priority")->check(CLI::Range(1, 99))->capture_default_str();
+  int cpu = -1;
+  app.add_option("--cpu", cpu, "pin the cycle thread to this CPU (the other threads keep off it)")->check(CLI::NonNegativeNumber);
+  std::string offset_text = "50,25,25";
+  app.add_option("--work-offset", offset_text,
+                 "X,Y,Z: where the tool tip is in the part's coordinates (mm) with the machine at home, from the touch-off")
+      ->capture_default_str();
+  double stick_out = 0.0, reference_stick_out = 0.0;
+  app.add_option("--tool-stick-out", stick_out, "the tool's stick-out below the holder (mm); with --reference-stick-out")
+      ->capture_default_str();
+  app.add_option("--reference-stick-out", reference_stick_out,
+                 "the stick-out of the tool the touch-off was made with (mm): a longer tool puts the tip lower")
+      ->capture_default_str();
+  std::string stock_text;
+  app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the whole workspace)");
+  std::string report_path;
+  app.add_option("--report", report_path, "write the run's figures here as JSON");
+  std::string journal_path;
+  app.add_option("--journal", journal_path, "record the job here (every cycle's sample and tool, safe-state events)");
+  double duration_s = 0.0;
+  app.add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
+  }
+  std::vector<double> numbers;
+  if (!parse_numbers(offset_text, numbers, 3)) {
+    return fail(kExitBadInput, "--work-offset " + offset_text + ": expected X,Y,Z in mm");
+  }
+  board::sherline_suzuki::WorkOffset offset;
+  offset.home_world_mm = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
+  offset.tool_stick_out_mm = stick_out;
+  offset.reference_stick_out_mm = reference_stick_out;
+  control::StockBlock stock{{0.0, 0.0, 0.0},
+                            {board::sherline_suzuki::kRig.workspace_mm[0], board::sherline_suzuki::kRig.workspace_mm[1],
+                             board::sherline_suzuki::kRig.workspace_mm[2]}};
+  if (!stock_text.empty()) {
+    if (!parse_numbers(stock_text, numbers, 6) || !(numbers[3] > numbers[0] && numbers[4] > numbers[1] && numbers[5] > numbers[2])) {
+      return fail(kExitBadInput, "--stock " + stock_text + ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low");
+    }
+    stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
+  }
+  if (!report_path.empty()) {  // found out now, not after the job
+    const bool existed = access(report_path.c_str(), F_OK) == 0;
+    std::ofstream probe(report_path, std::ios::app);
+    if (!probe) {
+      return fail(kExitBadInput, report_path + ": cannot be written");
+    }
+    probe.close();
+    if (!existed) {
+      std::remove(report_path.c_str());
+    }
   }
   const bool pio = haptic.rfind("pio:", 0) == 0;
   const bool can = haptic.rfind("can:", 0) == 0;
@@ -86,12 +175,19 @@ int main(int argc, char** argv) {
     return fail(kExitNotStarted, std::string("the mill's CY545: ") + port_error);
   }
   std::string error;
+  std::unique_ptr<hal::pio_shared_memory::SharedWindowMapping> window;
+  std::unique_ptr<hal::socketcan::FdCanChannel> channel;
+  std::unique_ptr<hal::pio_shared_memory::PioHapticDevice> pio_device;
+  std::unique_ptr<hal::socketcan::SocketCanHapticDevice> can_device;
+  hal::HapticDevice* device = nullptr;
   if (pio) {
     const std::string path = haptic.substr(4);
-    const auto window = hal::pio_shared_memory::SharedWindowMapping::open(path, 0, true, error);
+    window = hal::pio_shared_memory::SharedWindowMapping::open(path, 0, true, error);
     if (window == nullptr) {
       return fail(kExitNotStarted, "the haptic device's PIO window: " + error);
     }
+    pio_device = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
+    device = pio_device.get();
   } else {
     const std::string interface = haptic.substr(4);
     const canid_t ids[] = {hal::socketcan::kPoseAId, hal::socketcan::kPoseBId, hal::socketcan::kStatusId};
@@ -99,8 +195,94 @@ int main(int argc, char** argv) {
     if (fd < 0) {
       return fail(kExitNotStarted, "the haptic device's CAN link: " + error);
     }
-    hal::socketcan::FdCanChannel channel(fd);
+    channel = std::make_unique<hal::socketcan::FdCanChannel>(fd);
+    can_device = std::make_unique<hal::socketcan::SocketCanHapticDevice>(channel.get(), hal::kCornerOriginHapticRange);
+    device = can_device.get();
   }
-  return fail(kExitNotStarted,
-              "every link opened, but the rig's real-time run loop is not built yet; nothing was moved");
+
+  journal::JournalWriter journal_writer;
+  if (!journal_path.empty()) {
+    journal::JournalStart start;
+    start.tables_crc32 = part.header.crc32;
+    start.triangle_count = part.header.triangle_count;
+    start.unix_time_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    start.program = "stencil-rig";
+    if (!journal_writer.open(journal_path, start)) {
+      return fail(kExitBadInput, journal_writer.error());
+    }
+    std::printf("stencil-rig: journal %s\n", journal_path.c_str());
+  }
+
+  hal::posix_clock::MonotonicClock clock;
+  hal::cy545::Cy545Config link_config;
+  hal::cy545::Cy545Link link(port, clock, link_config);
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+  if (cpu >= 0 && !app::keep_off_cpu(cpu)) {
+    std::fprintf(stderr, "stencil-rig: the other threads could not be kept off CPU %d\n", cpu);
+  }
+  board::sherline_suzuki::RigJob job;
+  job.part = &part;
+  job.device = device;
+  job.machine = &link;
+  job.machine_clock = &clock;
+  job.offset = offset;
+  job.stock = stock;
+  job.journal = journal_writer.is_open() ? &journal_writer : nullptr;
+  job.interrupted = &interrupted;
+  job.duration_s = duration_s;
+  job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
+  std::printf("stencil-rig: homing the mill, then cutting; SIGINT (Ctrl-C) stops\n");
+  std::fflush(stdout);
+  const app::RealtimeOptions options{priority, cpu, require_rt};
+  const board::sherline_suzuki::RigResult result = board::sherline_suzuki::run_rig(
+      job, [&](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+               const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle, std::string& refused) {
+        const app::RealtimeSetup setup = app::run_periodic(options, period_ns, stop, cycle, [](const std::string& line) {
+          std::fprintf(stderr, "stencil-rig: %s\n", line.c_str());
+        });
+        refused = setup.refused.empty() ? "" : "--require-rt: " + setup.refused;
+        return setup.refused.empty();
+      });
+  const bool journal_closed = !journal_writer.is_open() || journal_writer.close();
+  if (!result.started) {
+    return fail(kExitNotStarted, result.error + ": " + link.last_error());
+  }
+  const char* reason = control::safe_reason_name(result.safe_state);
+  std::printf("stencil-rig: ran %.1f s, %llu cycles, %llu overruns, %llu periods skipped; wake-up p99 %.0f us, p99.9 %.0f us, "
+              "max %.0f us; max force %.2f N; %llu machine updates, max lag %.3f mm; the model has %.1f mm3 removed\n"
+              "stencil-rig: ended in the safe state: %s\n",
+              result.run_s, static_cast<unsigned long long>(result.cycles), static_cast<unsigned long long>(result.overruns),
+              static_cast<unsigned long long>(result.missed_periods), result.wakeup_p99_us, result.wakeup_p999_us,
+              result.wakeup_max_us, result.max_force_n, static_cast<unsigned long long>(result.machine_updates),
+              result.machine_max_lag_mm, result.model_removed_mm3, reason);
+  if (!result.error.empty()) {
+    std::fprintf(stderr, "stencil-rig: %s\n", result.error.c_str());
+  }
+  if (!journal_closed) {
+    std::fprintf(stderr, "stencil-rig: %s\n", journal_writer.error().c_str());
+  }
+  if (!report_path.empty()) {
+    const nlohmann::json report = {
+        {"cycles", result.cycles},
+        {"overruns", result.overruns},
+        {"missed_periods", result.missed_periods},
+        {"wakeup_latency_us", {{"p99", result.wakeup_p99_us}, {"p999", result.wakeup_p999_us}, {"max", result.wakeup_max_us}}},
+        {"compute_us", {{"p99", result.compute_p99_us}, {"max", result.compute_max_us}}},
+        {"max_force_n", result.max_force_n},
+        {"max_offset_mm", result.max_offset_mm},
+        {"machine", {{"updates", result.machine_updates}, {"max_lag_mm", result.machine_max_lag_mm}}},
+        {"stock_model", {{"removed_volume_mm3", result.model_removed_mm3}}},
+        {"safe_state", reason},
+        {"run_s", result.run_s}};
+    std::ofstream out(report_path);
+    if (!(out << report.dump(2) << "\n")) {
+      return fail(kExitBadInput, report_path + ": cannot be written");
+    }
+  }
+  const bool asked = result.safe_state == control::SafeReason::Stopped && result.error.empty() && journal_closed;
+  return asked ? 0 : kExitNotStarted;
 }

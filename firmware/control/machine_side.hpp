@@ -42,6 +42,14 @@ class MachineSide {
   // at most one target. A fault here is reported to the cycle and stops the machine.
   void update(hal::MonotonicNs update_deadline_ns);
 
+  // The end of a job: holds the feed and stops the machine if it is still cutting (no fault is
+  // reported; the cycle has stopped already).
+  void shut_down(hal::MonotonicNs deadline_ns) {
+    if (state_ == MachineSideState::Cutting) {
+      stop(deadline_ns, false);
+    }
+  }
+
   [[nodiscard]] MachineSideState state() const { return state_; }
   [[nodiscard]] hal::MachineFault fault() const { return link_.status().fault; }
   [[nodiscard]] const MachineSideStatistics& statistics() const { return statistics_; }

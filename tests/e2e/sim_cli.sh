@@ -286,6 +286,15 @@ case_rig_without_the_hardware_fails_cleanly() {
   run_rig --serial /dev/ttyS0 --haptic can:can0
   expect_status 2
   expect_stderr "--tables" "the missing option"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --work-offset 50,25
+  expect_status 2
+  expect_stderr "--work-offset 50,25: expected X,Y,Z in mm" "the work offset and what it expects"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --stock 0,0,0,50,25,abc
+  expect_status 2
+  expect_stderr "--stock 0,0,0,50,25,abc: expected X0,Y0,Z0,X1,Y1,Z1" "the stock and what it expects"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --report /nonexistent/rig.json
+  expect_status 2
+  expect_stderr "/nonexistent/rig.json: cannot be written" "the report that cannot be written, before anything opens"
 }
 
 if ! declare -F "case_$case_name" >/dev/null; then

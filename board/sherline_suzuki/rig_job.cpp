@@ -1,0 +1,169 @@
+// The rig's run: the parts built once, three threads around the cycle, a safe way out.
+#include "board/sherline_suzuki/rig_job.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "board/sherline_suzuki/rig_constants.hpp"
+#include "firmware/control/controller.hpp"
+#include "firmware/control/loop_statistics.hpp"
+#include "firmware/control/machine_side.hpp"
+#include "firmware/journal/journal_drain.hpp"
+
+namespace stencil::board::sherline_suzuki {
+namespace {
+
+constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
+constexpr auto kUpdateNs = static_cast<hal::MonotonicNs>(1e9 / kRig.machine_update_hz);
+constexpr double kModelCellMm = 0.05;
+// The virtual tool is held to what the mill follows over the serial line (as in the simulation,
+// which mirrors the rig): 1 mm/s per axis and in |dx| + |dy| + |dz|.
+constexpr double kVirtualToolSpeedMmPerS = 1.0;
+
+}  // namespace
+
+motion::MachineFrames rig_frames(const WorkOffset& offset) {
+  Eigen::Vector3d home = offset.home_world_mm;
+  home.z() -= offset.tool_stick_out_mm - offset.reference_stick_out_mm;
+  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, {-1, -1, -1}, kRig.steps_per_mm};
+}
+
+RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
+  RigResult result;
+  const tables::PartTables& part = *job.part;
+  const motion::MachineFrames frames = rig_frames(job.offset);
+
+  auto commands = std::make_unique<control::CommandRing>();
+  auto machine_events = std::make_unique<control::MachineEventRing>();
+  auto handoffs = std::make_unique<control::MachineHandoffRing>();
+  auto telemetry = std::make_unique<control::TelemetryRing>();
+  auto journal = std::make_unique<control::JournalRing>();
+  journal::JournalDrain records{job.journal, *commands};
+
+  control::ControllerConfig config;
+  config.frames = frames;
+  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
+  config.device_high_mm = Eigen::Vector3d(kRig.haptic_workspace_mm[0] + 25.0, kRig.haptic_workspace_mm[1] + 25.0,
+                                          kRig.haptic_workspace_mm[2] + 25.0);
+  config.home_tip_mm = frames.home_world_mm;
+  config.count_overruns = true;
+  config.overrun_limit = job.overrun_limit;
+  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  auto controller = std::make_unique<control::Controller>(
+      part, *job.device, control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
+  if (!controller->ready()) {
+    result.error = "the tables' tool could not be grown for the touched set";
+    return result;
+  }
+  const motion::PlannerLimits limits{{kRig.max_speed_mm_per_s, 1000.0, kRig.steps_per_mm},
+                                     1.0 / kRig.machine_update_hz,
+                                     {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
+                                      static_cast<std::int32_t>(backlash_steps(2))}};
+  auto machine = std::make_unique<control::MachineSide>(part, *job.machine, frames, limits, *handoffs, *machine_events);
+  std::vector<float> model_cells(control::CommandedStock::cells_needed(job.stock, kModelCellMm));
+  control::CommandedStock model(job.stock, kModelCellMm, part.tool.spec, model_cells);
+  if (model.ready()) {
+    machine->keep_stock_model(&model);
+  }
+  hal::Clock& clock = *job.machine_clock;
+  if (!machine->start(clock.now_ns() + 120'000'000'000)) {
+    result.error = "the machine did not start (wake, home, spindle on)";
+    return result;
+  }
+  result.started = true;
+
+  std::atomic<bool> stop{false};
+  std::atomic<hal::MonotonicNs> start_ns{0};
+  std::thread machine_thread([&] {
+    hal::MonotonicNs next = clock.now_ns();
+    while (!stop.load()) {
+      clock.sleep_until_ns(next);
+      machine->update(next + 2 * kUpdateNs);
+      next = std::max(next + kUpdateNs, clock.now_ns());
+    }
+  });
+  std::thread records_thread([&] {
+    auto next_progress = std::chrono::steady_clock::now() + std::chrono::seconds(1);
+    control::Telemetry last{};
+    bool stop_sent = false;
+    while (!stop.load()) {
+      records.drain(*journal);
+      records.sync_if_due();
+      control::Telemetry frame{};
+      while (telemetry->pop(frame)) {
+        last = frame;
+      }
+      // The run ends through the cycle's own stop (this thread is the command ring's one producer):
+      // on SIGINT/SIGTERM, or when the duration is up.
+      const hal::MonotonicNs started = start_ns.load();
+      const bool time_up = job.duration_s > 0.0 && started != 0 &&
+                           static_cast<double>(clock.now_ns() - started) / 1e9 >= job.duration_s;
+      if (!stop_sent && ((job.interrupted != nullptr && job.interrupted->load()) || time_up)) {
+        stop_sent = commands->push({control::CommandKind::Stop});
+      }
+      if (job.progress && std::chrono::steady_clock::now() >= next_progress) {
+        char line[160];
+        std::snprintf(line, sizeof line, "cycle %llu, tool at (%.3f, %.3f, %.3f) mm, force %.2f N",
+                      static_cast<unsigned long long>(last.cycle), last.virtual_tip_mm[0], last.virtual_tip_mm[1],
+                      last.virtual_tip_mm[2],
+                      std::sqrt(last.force_n[0] * last.force_n[0] + last.force_n[1] * last.force_n[1] +
+                                last.force_n[2] * last.force_n[2]));
+        job.progress(line);
+        next_progress += std::chrono::seconds(1);
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+
+  std::string runner_error;
+  const bool ran = runner(
+      kPeriodNs, stop,
+      [&](hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+        if (start_ns.load(std::memory_order_relaxed) == 0) {
+          start_ns.store(deadline_ns);
+        }
+        const control::CycleStatus status = controller->step(now_ns, deadline_ns);
+        controller->finish(clock.now_ns(), deadline_ns + kPeriodNs);
+        // Never an automatic resume: a safe state (a fault, or the stop that ends every run) ends
+        // the run; the machine side holds and stops the mill.
+        return status != control::CycleStatus::SafeState;
+      },
+      runner_error);
+  // Two machine updates, so the safe state reaches the mill (hold, then stop), then all stop.
+  std::this_thread::sleep_for(std::chrono::nanoseconds(3 * kUpdateNs));
+  stop.store(true);
+  machine_thread.join();
+  records_thread.join();
+  records.drain(*journal);
+  // The runner refused before the cycle ran (or the cycle never reached the machine side): the
+  // machine is stopped here all the same.
+  machine->shut_down(clock.now_ns() + 2 * kUpdateNs);
+  if (!ran) {
+    result.error = runner_error;
+  }
+  const control::LoopStatistics& statistics = controller->statistics();
+  result.cycles = statistics.cycles;
+  result.overruns = statistics.overruns;
+  result.missed_periods = statistics.missed_periods;
+  result.wakeup_p99_us = statistics.wakeup_latency.quantile_us(0.99);
+  result.wakeup_p999_us = statistics.wakeup_latency.quantile_us(0.999);
+  result.wakeup_max_us = static_cast<double>(statistics.wakeup_latency.max_ns()) / 1000.0;
+  result.compute_p99_us = statistics.compute.quantile_us(0.99);
+  result.compute_max_us = static_cast<double>(statistics.compute.max_ns()) / 1000.0;
+  result.max_force_n = controller->max_force_n();
+  result.max_offset_mm = controller->max_offset_mm();
+  result.machine_updates = machine->statistics().updates;
+  result.machine_max_lag_mm = machine->statistics().max_lag_mm;
+  result.model_removed_mm3 = model.ready() ? model.removed_volume_mm3() : 0.0;
+  result.run_s = start_ns.load() != 0 ? static_cast<double>(clock.now_ns() - start_ns.load()) / 1e9 : 0.0;
+  result.safe_state = controller->safe_reason();
+  return result;
+}
+
+}  // namespace stencil::board::sherline_suzuki

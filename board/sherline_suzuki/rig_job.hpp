@@ -1,0 +1,77 @@
+// The rig's run: the controller's cycle on the real-time runner, the machine side on a thread of its
+// own at the update rate, and a records thread (journal, progress, signals), wired to whatever
+// haptic device and machine link the caller opened: the PIO card or SocketCAN and the CY545 on
+// the rig, the fakes in the tests. The frames are the rig's, shifted by the work offset.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "firmware/control/commanded_stock.hpp"
+#include "firmware/control/safe_state.hpp"
+#include "firmware/journal/journal_writer.hpp"
+#include "firmware/motion/machine_frames.hpp"
+#include "firmware/tables/part_tables.hpp"
+#include "hal/clock.hpp"
+#include "hal/haptic_device.hpp"
+#include "hal/machine_link.hpp"
+
+namespace stencil::board::sherline_suzuki {
+
+// Where the tool tip is in the world (the part's coordinates) when the machine is at home, from the
+// touch-off, and the tool's stick-out below the holder against the one the touch-off was made with.
+struct WorkOffset {
+  Eigen::Vector3d home_world_mm{50.0, 25.0, 25.0};  // the tip at home: the workspace's far top corner
+  double tool_stick_out_mm = 0.0;                   // 0: the touch-off's own tool
+  double reference_stick_out_mm = 0.0;
+};
+
+// The rig's frames: world = device / 10, every axis counting into the workspace from its switch;
+// a tool that sticks out further puts the tip lower at home.
+[[nodiscard]] motion::MachineFrames rig_frames(const WorkOffset& offset);
+
+// As stencil-sim's: cycle(now_ns, deadline_ns) once per period until it returns false or stop.
+using PeriodicRunner = std::function<bool(hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+                                          const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
+                                          std::string& error)>;
+
+struct RigJob {
+  const tables::PartTables* part = nullptr;
+  hal::HapticDevice* device = nullptr;
+  hal::MachineLink* machine = nullptr;
+  hal::Clock* machine_clock = nullptr;  // the link's clock: the machine thread paces on it
+  WorkOffset offset;
+  control::StockBlock stock{};          // for the controller's model of the machined stock
+  journal::JournalWriter* journal = nullptr;
+  const std::atomic<bool>* interrupted = nullptr;  // SIGINT/SIGTERM: a stop command to the cycle
+  double duration_s = 0.0;                          // 0: until interrupted or a safe state
+  // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
+  // hosts they run on are not real-time hosts (make latency measures what a host gives).
+  int overrun_limit = 3;
+  std::function<void(const std::string&)> progress;  // a line about every second
+};
+
+struct RigResult {
+  bool started = false;
+  std::string error;
+  std::uint64_t cycles = 0, overruns = 0, missed_periods = 0;
+  double wakeup_p99_us = 0.0, wakeup_p999_us = 0.0, wakeup_max_us = 0.0;
+  double compute_p99_us = 0.0, compute_max_us = 0.0;
+  double max_force_n = 0.0, max_offset_mm = 0.0;
+  std::uint64_t machine_updates = 0;
+  double machine_max_lag_mm = 0.0;
+  double model_removed_mm3 = 0.0;
+  double run_s = 0.0;
+  control::SafeReason safe_state = control::SafeReason::None;
+  std::string journal_error;
+};
+
+// Homes the machine, then runs until the duration, an interrupt or a safe state; on the way out
+// the machine is held and stopped. Blocks.
+[[nodiscard]] RigResult run_rig(const RigJob& job, const PeriodicRunner& runner);
+
+}  // namespace stencil::board::sherline_suzuki

@@ -1,0 +1,46 @@
+// JournalDrain: the journal thread's loop body. Every record the cycle left in its journal ring
+// goes to the journal file (when there is one); a record that cannot be written asks the cycle to
+// stop, once, on its command ring: the record must lose nothing. The thread that drains is the
+// command ring's one producer.
+#pragma once
+
+#include <chrono>
+
+#include "firmware/control/cycle_messages.hpp"
+#include "firmware/journal/journal_writer.hpp"
+
+namespace stencil::journal {
+
+class JournalDrain {
+ public:
+  JournalDrain(JournalWriter* writer, control::CommandRing& commands) : writer_(writer), commands_(commands) {}
+
+  void drain(control::JournalRing& ring) {
+    control::JournalRecord record{};
+    while (ring.pop(record)) {
+      if (writer_ != nullptr && !failed_ && !writer_->append(record)) {
+        fail();
+      }
+    }
+  }
+
+  void sync_if_due() {
+    const auto now = std::chrono::steady_clock::now().time_since_epoch();
+    if (writer_ != nullptr && !failed_ &&
+        !writer_->sync_if_due(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count())) {
+      fail();
+    }
+  }
+
+ private:
+  void fail() {
+    failed_ = true;
+    static_cast<void>(commands_.push({control::CommandKind::JournalFailed}));
+  }
+
+  JournalWriter* writer_;
+  control::CommandRing& commands_;
+  bool failed_ = false;
+};
+
+}  // namespace stencil::journal
