@@ -194,6 +194,28 @@ case_journal_holds_every_cycle() {
   [ ! -e report2.json ] || fail "a refused run left a report behind"
 }
 
+# SIGTERM mid-cut: the run ends in the safe state "stopped" (exit 3) with its report and journal
+# written, the safe-state event in the journal (18 bytes after the cycles').
+case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
+  echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIGTERM after 3 s)"
+  "$sim" --speed 10 --pattern raster --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
+  local pid=$!
+  sleep 3
+  kill -TERM "$pid"
+  wait "$pid"
+  status=$?
+  sed 's/^/  stdout: /' stdout.txt
+  echo "  exit status $status"
+  expect_status 3
+  grep -q '"safe_state": "stopped"' report.json || fail "the report does not give the safe state stopped: $(grep safe_state report.json)"
+  grep -q "safe state: stopped" stdout.txt || fail "the summary does not say the run was stopped"
+  local cycles size
+  cycles=$(json_number report.json cycles)
+  size=$(stat -c %s job.journal)
+  [ "$size" -eq $((12 + 38 + 95 * cycles + 18)) ] ||
+    fail "job.journal is $size bytes; expected $((12 + 38 + 95 * cycles + 18)) ($cycles cycles and the safe-state event)"
+}
+
 case_refuses_a_bad_operator_csv() {
   printf 't_s,x_mm,y_mm,z_mm\n0,250,125,200\n0.5,250,abc,200\n' >operator.csv
   run_sim --fast --operator operator.csv --report report.json
