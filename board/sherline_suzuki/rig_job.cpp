@@ -53,6 +53,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   config.home_tip_mm = frames.home_world_mm;
   config.count_overruns = true;
   config.overrun_limit = job.overrun_limit;
+  config.stale_periods = job.stale_periods;
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   auto controller = std::make_unique<control::Controller>(
@@ -80,6 +81,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
 
   std::atomic<bool> stop{false};
   std::atomic<hal::MonotonicNs> start_ns{0};
+  std::atomic<control::SafeReason> first_fault{control::SafeReason::None};
+  std::atomic<bool> stop_asked{false};
   std::thread machine_thread([&] {
     hal::MonotonicNs next = clock.now_ns();
     while (!stop.load()) {
@@ -97,7 +100,20 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
       records.sync_if_due();
       control::Telemetry frame{};
       while (telemetry->pop(frame)) {
+        if (job.progress && frame.safe_reason != last.safe_reason) {
+          job.progress(frame.safe_reason == control::SafeReason::None
+                           ? std::string("force restored; the mill stays stopped (re-homing to resume the cut is not built yet)")
+                           : std::string("SAFE STATE: ") + control::safe_reason_name(frame.safe_reason) +
+                                 ": no force, the mill held and stopped. Hold the handle still near the tool and type "
+                                 "'reset' to feel the part again; Ctrl-C ends the run");
+        }
+        if (job.progress && frame.reset_requests != last.reset_requests && frame.last_reset != control::ResetOutcome::Accepted) {
+          job.progress(std::string("reset refused: ") + control::reset_outcome_name(frame.last_reset));
+        }
         last = frame;
+      }
+      if (!stop_sent && job.reset_requested && job.reset_requested()) {
+        static_cast<void>(commands->push({control::CommandKind::Reset}));
       }
       // The run ends through the cycle's own stop (this thread is the command ring's one producer):
       // on SIGINT/SIGTERM, or when the duration is up.
@@ -105,6 +121,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
       const bool time_up = job.duration_s > 0.0 && started != 0 &&
                            static_cast<double>(clock.now_ns() - started) / 1e9 >= job.duration_s;
       if (!stop_sent && ((job.interrupted != nullptr && job.interrupted->load()) || time_up)) {
+        stop_asked.store(true, std::memory_order_release);
         stop_sent = commands->push({control::CommandKind::Stop});
       }
       if (job.progress && std::chrono::steady_clock::now() >= next_progress) {
@@ -130,9 +147,16 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
         }
         const control::CycleStatus status = controller->step(now_ns, deadline_ns);
         controller->finish(clock.now_ns(), deadline_ns + kPeriodNs);
-        // Never an automatic resume: a safe state (a fault, or the stop that ends every run) ends
-        // the run; the machine side holds and stops the mill.
-        return status != control::CycleStatus::SafeState;
+        const control::SafeReason reason = controller->safe_reason();
+        if (reason != control::SafeReason::None && reason != control::SafeReason::Stopped &&
+            first_fault.load(std::memory_order_relaxed) == control::SafeReason::None) {
+          first_fault.store(reason, std::memory_order_relaxed);
+        }
+        // The stop that ends every run ends the loop; a fault's safe state keeps the cycle running
+        // (zero force) for a reset, never an automatic one.
+        // (A stop in a fault's safe state keeps the fault as the latched reason, so the loop ends
+        // on the stop having been asked, once the cycle is safe.)
+        return !(status == control::CycleStatus::SafeState && stop_asked.load(std::memory_order_acquire));
       },
       runner_error);
   // Two machine updates, so the safe state reaches the mill (hold, then stop), then all stop.
@@ -163,6 +187,10 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   result.model_removed_mm3 = model.ready() ? model.removed_volume_mm3() : 0.0;
   result.run_s = start_ns.load() != 0 ? static_cast<double>(clock.now_ns() - start_ns.load()) / 1e9 : 0.0;
   result.safe_state = controller->safe_reason();
+  result.first_fault = first_fault.load();
+  result.safe_state_entries = controller->counters().safe_state_entries;
+  result.resets_accepted = controller->counters().resets_accepted;
+  result.resets_refused = controller->counters().resets_refused;
   return result;
 }
 

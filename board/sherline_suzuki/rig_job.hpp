@@ -52,7 +52,12 @@ struct RigJob {
   // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
   // hosts they run on are not real-time hosts (make latency measures what a host gives).
   int overrun_limit = 3;
-  std::function<void(const std::string&)> progress;  // a line about every second
+  // More periods than this without a fresh device sample is a safe state: 5 on the rig (the tests
+  // raise it for the same reason: their simulated device is a thread on a host that stalls).
+  int stale_periods = 5;
+  std::function<void(const std::string&)> progress;  // a line about every second, and every event
+  // Polled by the records thread: true when the operator asks for a reset (typed at the terminal).
+  std::function<bool()> reset_requested;
 };
 
 struct RigResult {
@@ -66,12 +71,17 @@ struct RigResult {
   double machine_max_lag_mm = 0.0;
   double model_removed_mm3 = 0.0;
   double run_s = 0.0;
-  control::SafeReason safe_state = control::SafeReason::None;
+  control::SafeReason safe_state = control::SafeReason::None;  // at the end (stopped: as asked)
+  control::SafeReason first_fault = control::SafeReason::None;  // the first safe state not asked for
+  std::uint64_t safe_state_entries = 0;
+  std::uint64_t resets_accepted = 0, resets_refused = 0;
   std::string journal_error;
 };
 
-// Homes the machine, then runs until the duration, an interrupt or a safe state; on the way out
-// the machine is held and stopped. Blocks.
+// Homes the machine, then runs until the duration or an interrupt; on the way out the machine is
+// held and stopped. A fault's safe state (zero force, the mill held and stopped) keeps the cycle
+// running until a reset restores the force (the mill stays stopped: re-homing to resume is not
+// built) or the run is stopped. Blocks.
 [[nodiscard]] RigResult run_rig(const RigJob& job, const PeriodicRunner& runner);
 
 }  // namespace stencil::board::sherline_suzuki

@@ -3,6 +3,7 @@
 // everything it can (the host's real-time readiness, the tables, the serial port, the haptic link)
 // and says plainly what is missing, then homes the mill and runs the cycle until SIGINT/SIGTERM,
 // --duration or a safe state, and stops the machine on the way out.
+#include <poll.h>
 #include <signal.h>
 #include <unistd.h>
 
@@ -50,6 +51,49 @@ int fail(int status, const std::string& message) {
 std::atomic<bool> interrupted{false};
 void on_signal(int) { interrupted.store(true); }
 
+// The operator's lines at the terminal, read without waiting (from the records thread only): true
+// once a line says "reset". Anything else typed is answered with what is understood.
+class TerminalCommands {
+ public:
+  bool reset_typed() {
+    if (closed_) {
+      return false;
+    }
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    while (poll(&in, 1, 0) > 0 && (in.revents & (POLLIN | POLLHUP)) != 0) {
+      char bytes[256];
+      const ssize_t n = ::read(STDIN_FILENO, bytes, sizeof bytes);
+      if (n <= 0) {
+        closed_ = true;  // end of input (not a terminal, or closed): nothing more to read
+        break;
+      }
+      pending_.append(bytes, static_cast<std::size_t>(n));
+    }
+    bool reset = false;
+    for (std::size_t end = pending_.find('\n'); end != std::string::npos; end = pending_.find('\n')) {
+      std::string line = pending_.substr(0, end);
+      pending_.erase(0, end + 1);
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) {
+        line.pop_back();
+      }
+      if (line == "reset") {
+        reset = true;
+      } else if (!line.empty()) {
+        std::fprintf(stderr, "stencil-rig: '%s' is not a command: type 'reset' (in the safe state) or Ctrl-C to end\n",
+                     line.c_str());
+      }
+    }
+    if (pending_.size() > 1024) {
+      pending_.clear();  // a line that long is not a command
+    }
+    return reset;
+  }
+
+ private:
+  std::string pending_;
+  bool closed_ = false;
+};
+
 // "X,Y,Z" (or six numbers for a block) as finite numbers, all of each field: false otherwise.
 bool parse_numbers(const std::string& text, std::vector<double>& out, std::size_t count) {
   out.clear();
@@ -74,9 +118,11 @@ int main(int argc, char** argv) {
   CLI::App app{
       "stencil-rig: the haptic stencil controller on the Sherline + Suzuki rig. Checks the host's real-time\n"
       "readiness, loads the tables, opens the CY545's serial port and the haptic device's link, and says what\n"
-      "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM, --duration or a safe\n"
-      "state, and holds and stops the mill on the way out. A safe state ends the run (no resume yet).\n"
-      "Exit status: 0 stopped as asked, 2 bad input, 3 could not start or ended in a safe state."};
+      "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM or --duration, and holds\n"
+      "and stops the mill on the way out. In a fault's safe state (no force, the mill held and\n"
+      "stopped) type 'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
+      "stopped (re-homing to resume the cut is not built yet).\n"
+      "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened."};
   std::string tables_path;
   std::string serial_path;
   std::string haptic;
@@ -235,6 +281,8 @@ int main(int argc, char** argv) {
   job.interrupted = &interrupted;
   job.duration_s = duration_s;
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
+  TerminalCommands terminal;
+  job.reset_requested = [&terminal] { return terminal.reset_typed(); };
   std::printf("stencil-rig: homing the mill, then cutting; SIGINT (Ctrl-C) stops\n");
   std::fflush(stdout);
   const app::RealtimeOptions options{priority, cpu, require_rt};
@@ -254,11 +302,14 @@ int main(int argc, char** argv) {
   const char* reason = control::safe_reason_name(result.safe_state);
   std::printf("stencil-rig: ran %.1f s, %llu cycles, %llu overruns, %llu periods skipped; wake-up p99 %.0f us, p99.9 %.0f us, "
               "max %.0f us; max force %.2f N; %llu machine updates, max lag %.3f mm; the model has %.1f mm3 removed\n"
-              "stencil-rig: ended in the safe state: %s\n",
+              "stencil-rig: ended in the safe state: %s; faults: %s (%llu safe-state entries, %llu resets taken, %llu refused)\n",
               result.run_s, static_cast<unsigned long long>(result.cycles), static_cast<unsigned long long>(result.overruns),
               static_cast<unsigned long long>(result.missed_periods), result.wakeup_p99_us, result.wakeup_p999_us,
               result.wakeup_max_us, result.max_force_n, static_cast<unsigned long long>(result.machine_updates),
-              result.machine_max_lag_mm, result.model_removed_mm3, reason);
+              result.machine_max_lag_mm, result.model_removed_mm3, reason,
+              result.first_fault == control::SafeReason::None ? "none" : control::safe_reason_name(result.first_fault),
+              static_cast<unsigned long long>(result.safe_state_entries),
+              static_cast<unsigned long long>(result.resets_accepted), static_cast<unsigned long long>(result.resets_refused));
   if (!result.error.empty()) {
     std::fprintf(stderr, "stencil-rig: %s\n", result.error.c_str());
   }
@@ -277,12 +328,16 @@ int main(int argc, char** argv) {
         {"machine", {{"updates", result.machine_updates}, {"max_lag_mm", result.machine_max_lag_mm}}},
         {"stock_model", {{"removed_volume_mm3", result.model_removed_mm3}}},
         {"safe_state", reason},
+        {"first_fault", result.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)
+                                                                          : nlohmann::json(control::safe_reason_name(result.first_fault))},
+        {"resets", {{"accepted", result.resets_accepted}, {"refused", result.resets_refused}}},
         {"run_s", result.run_s}};
     std::ofstream out(report_path);
     if (!(out << report.dump(2) << "\n")) {
       return fail(kExitBadInput, report_path + ": cannot be written");
     }
   }
-  const bool asked = result.safe_state == control::SafeReason::Stopped && result.error.empty() && journal_closed;
+  const bool asked = result.safe_state == control::SafeReason::Stopped && result.first_fault == control::SafeReason::None &&
+                     result.error.empty() && journal_closed;
   return asked ? 0 : kExitNotStarted;
 }

@@ -257,6 +257,8 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   telemetry.max_depth_mm = contact.max_depth_mm;
   telemetry.touched_triangles = static_cast<std::uint32_t>(touched_.count());
   telemetry.safe_reason = safe_reason_;
+  telemetry.reset_requests = static_cast<std::uint32_t>(counters_.resets_accepted + counters_.resets_refused);
+  telemetry.last_reset = last_reset_;
   if (!rings_.telemetry.push(telemetry)) {
     ++counters_.telemetry_dropped;
   }

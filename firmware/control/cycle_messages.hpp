@@ -29,6 +29,23 @@ enum class ResetOutcome : std::uint8_t {
   DeviceNotReady,     // no fresh sample, or the haptic link still latches a fault
 };
 
+// What a reset came to, for the operator ("accepted", "device_not_still", ...).
+[[nodiscard]] constexpr const char* reset_outcome_name(ResetOutcome outcome) {
+  switch (outcome) {
+    case ResetOutcome::Accepted:
+      return "accepted";
+    case ResetOutcome::NotInSafeState:
+      return "not_in_safe_state";
+    case ResetOutcome::DeviceNotStill:
+      return "device_not_still";
+    case ResetOutcome::DeviceFarFromTool:
+      return "device_far_from_tool";
+    case ResetOutcome::DeviceNotReady:
+      return "device_not_ready";
+  }
+  return "unknown";
+}
+
 // Every cycle, to the machine side: where the virtual tool is (world mm, always legal) and whether
 // the machine must stop.
 struct MachineHandoff {
@@ -60,6 +77,8 @@ struct Telemetry {
   std::uint32_t touched_triangles;
   engine::RemediationStatus remediation;
   SafeReason safe_reason;
+  std::uint32_t reset_requests;  // reset commands taken so far (accepted or refused)
+  ResetOutcome last_reset;       // what the newest of them came to
 };
 
 // Everything a replay needs and nothing is allowed to lose: the journal ring being full is a fault.

@@ -7,6 +7,9 @@
 #include <cmath>
 #include <thread>
 
+#include <pthread.h>
+#include <sched.h>
+
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/app/realtime_thread.hpp"
 #include "firmware/tables/table_loader.hpp"
@@ -48,7 +51,13 @@ struct FakeRig {
   std::atomic<bool> device_frozen{false};
   std::thread device_thread;
 
-  FakeRig() {
+  // The hand holds the handle where the tool is at home, then draws it 1 mm (world) towards -x.
+  static sim::SimulatedPose drawn_back(std::uint32_t counter, hal::MonotonicNs) {
+    const double moved = std::min(10.0, 0.005 * counter);  // device mm: 5 mm/s, for 2 s
+    return sim::SimulatedPose{{500.0 - moved, 250.0, 250.0}, {0.0, 0.0}};
+  }
+
+  explicit FakeRig(const sim::PoseSource& pose = drawn_back) {
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
     fake_runner = std::make_unique<sim::cy545::FakeCy545Runner>(fake);
     char port_error[256] = {};
@@ -59,14 +68,15 @@ struct FakeRig {
     window = hal::pio_shared_memory::SharedWindowMapping::create_memfd("rig-loop-tests", error);
     CHECK(window != nullptr);
     device_link = std::make_unique<sim::PioDeviceLink>(window->window());
-    // The hand holds the handle where the tool is at home, then draws it 1 mm (world) towards -x.
-    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, [](std::uint32_t counter, hal::MonotonicNs) {
-      const double moved = std::min(10.0, 0.005 * counter);  // device mm: 5 mm/s, for 2 s
-      return sim::SimulatedPose{{500.0 - moved, 250.0, 250.0}, {0.0, 0.0}};
-    });
+    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, pose);
     host = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
     device->step(sim::cy545::FakeCy545Runner::monotonic_now_ns());
     device_thread = std::thread([this] {
+      // The device's own loop is hard real time on its card: SCHED_FIFO here where allowed, so
+      // the host's noise does not make it look stale.
+      sched_param param{};
+      param.sched_priority = 70;
+      static_cast<void>(pthread_setschedparam(pthread_self(), SCHED_FIFO, &param));
       auto next = std::chrono::steady_clock::now();
       while (device_running.load()) {
         next += std::chrono::milliseconds(1);
@@ -104,6 +114,7 @@ struct FakeRig {
     // Not a real-time host: overruns are counted but do not end the run here (the overrun storm has
     // its own test in tests/control).
     j.overrun_limit = 1'000'000;
+    j.stale_periods = 100;  // 0.1 s: a stalled thread here is not a disconnected device
     return j;
   }
 
@@ -141,17 +152,20 @@ TEST(RigLoop, HomesFollowsTheDeviceAndStopsTheMillWhenItsTimeIsUp) {
   CHECK_FALSE(rig.spindle_on());  // stopped on the way out
 }
 
-TEST(RigLoop, ADeviceThatFreezesEndsTheRunInTheSafeStateWithTheMillStopped) {
+TEST(RigLoop, ADeviceThatFreezesIsASafeStateWithTheMillStoppedAndNoForceUntilTheRunEnds) {
   FakeRig rig;
   std::thread freezer([&rig] {
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // homing, then half a second of cutting
+    std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // homing, then some cutting
     rig.device_frozen.store(true);
   });
-  const rig::RigResult result = rig::run_rig(rig.job(10.0), unprivileged_runner());
+  const rig::RigResult result = rig::run_rig(rig.job(3.0), unprivileged_runner());
   freezer.join();
+  CHECK(result.run_s > 2.5);  // the safe state did not end the run: its time did
   CHECK_TRUE(result.started);
-  CHECK(result.safe_state == control::SafeReason::DeviceStale);
-  CHECK(result.run_s < 5.0);  // well before the duration
+  // The backend's heartbeat watchdog sees the frozen device first here (the cycle's own stale
+  // watchdog is raised to 0.1 s for this host); on the rig, 5 periods without a sample come first.
+  STRCMP_EQUAL("device_fault", control::safe_reason_name(result.first_fault));
+  STRCMP_EQUAL("device_fault", control::safe_reason_name(result.safe_state));  // latched to the end
   CHECK_FALSE(rig.spindle_on());
   // The last thing the host wrote to the device: no force, enable off.
   rig.stop_device_thread();
@@ -160,4 +174,46 @@ TEST(RigLoop, ADeviceThatFreezesEndsTheRunInTheSafeStateWithTheMillStopped) {
   const sim::DeviceOutput output = rig.device->output();
   CHECK_FALSE(output.force_applied);
   DOUBLES_EQUAL(0.0, std::hypot(output.force_n[0], output.force_n[1], output.force_n[2]), 0.0);
+}
+
+// A jerk of the handle (a sample 100 mm off for 3 ms) is a pose jump; the operator then holds the
+// handle still where it was and types reset: refused while it has not been still for 0.5 s, then
+// taken.
+TEST(RigLoop, APoseJumpIsASafeStateThatAResetLeavesOnceTheHandleIsHeldStill) {
+  std::atomic<std::uint32_t> jump_at{0xffffffffU};
+  std::atomic<std::uint32_t> latest{0};
+  FakeRig rig([&jump_at, &latest](std::uint32_t counter, hal::MonotonicNs) {
+    latest.store(counter);
+    const bool off = counter >= jump_at.load() && counter < jump_at.load() + 3;
+    return sim::SimulatedPose{{off ? 400.0 : 500.0, 250.0, 250.0}, {0.0, 0.0}};
+  });
+  std::atomic<int> resets_to_send{0};
+  std::atomic<bool> running{false};
+  rig::RigJob job = rig.job(4.0);
+  job.reset_requested = [&resets_to_send, &running] {  // polled once the machine is homed and the cycle runs
+    running.store(true);
+    if (resets_to_send.load() > 0) {
+      resets_to_send.fetch_sub(1);
+      return true;
+    }
+    return false;
+  };
+  std::thread operator_hand([&] {
+    while (!running.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    jump_at.store(latest.load() + 50);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    resets_to_send.store(1);  // 150 ms after the jump: not yet still for 0.5 s
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    resets_to_send.store(1);  // still for over a second now
+  });
+  const rig::RigResult result = rig::run_rig(job, unprivileged_runner());
+  operator_hand.join();
+  STRCMP_EQUAL("pose_jump", control::safe_reason_name(result.first_fault));
+  LONGS_EQUAL(1, result.resets_refused);
+  LONGS_EQUAL(1, result.resets_accepted);
+  STRCMP_EQUAL("stopped", control::safe_reason_name(result.safe_state));
+  CHECK_FALSE(rig.spindle_on());  // stopped at the jump, and it stays stopped
 }
