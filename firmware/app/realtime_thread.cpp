@@ -107,12 +107,12 @@ RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs peri
         break;
       }
       deadline += period_ns;
-      // Woken so late that the next period is already gone (a stall of the host, not of the cycle):
-      // skip to the next period boundary rather than run a burst of late cycles back to back, each
-      // of which would overrun in turn. The controller counts the periods skipped.
+      // Periods that went by whole while the cycle was late (a stall of the host) are skipped
+      // rather than run back to back, each of which would overrun in turn; the period now under
+      // way runs at once, late. The controller counts the periods skipped.
       const hal::MonotonicNs now = monotonic_now();
-      if (now >= deadline) {
-        deadline += ((now - deadline) / period_ns + 1) * period_ns;
+      if (now >= deadline + period_ns) {
+        deadline += ((now - deadline) / period_ns) * period_ns;
       }
     }
   });

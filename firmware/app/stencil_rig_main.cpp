@@ -141,9 +141,11 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   double stick_out = 0.0, reference_stick_out = 0.0;
   app.add_option("--tool-stick-out", stick_out, "the tool's stick-out below the holder (mm); with --reference-stick-out")
+      ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   app.add_option("--reference-stick-out", reference_stick_out,
                  "the stick-out of the tool the touch-off was made with (mm): a longer tool puts the tip lower")
+      ->check(CLI::Range(0.0, 100.0))
       ->capture_default_str();
   std::string stock_text;
   app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the whole workspace)");
@@ -159,6 +161,10 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
   }
+  // (CLI11's range check lets a NaN through: every comparison with it is false.)
+  if (!std::isfinite(stick_out) || !std::isfinite(reference_stick_out)) {
+    return fail(kExitBadInput, "--tool-stick-out and --reference-stick-out: expected a length in mm from 0 to 100");
+  }
   std::vector<double> numbers;
   if (!parse_numbers(offset_text, numbers, 3)) {
     return fail(kExitBadInput, "--work-offset " + offset_text + ": expected X,Y,Z in mm");
@@ -171,8 +177,15 @@ int main(int argc, char** argv) {
                             {board::sherline_suzuki::kRig.workspace_mm[0], board::sherline_suzuki::kRig.workspace_mm[1],
                              board::sherline_suzuki::kRig.workspace_mm[2]}};
   if (!stock_text.empty()) {
-    if (!parse_numbers(stock_text, numbers, 6) || !(numbers[3] > numbers[0] && numbers[4] > numbers[1] && numbers[5] > numbers[2])) {
-      return fail(kExitBadInput, "--stock " + stock_text + ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low");
+    bool inside = parse_numbers(stock_text, numbers, 6);
+    for (int axis = 0; inside && axis < 3; ++axis) {
+      const auto a = static_cast<std::size_t>(axis);
+      inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= board::sherline_suzuki::kRig.workspace_mm[a];
+    }
+    if (!inside) {
+      return fail(kExitBadInput, "--stock " + stock_text +
+                                     ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace "
+                                     "[0,50]x[0,25]x[0,25]");
     }
     stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
   }
@@ -297,7 +310,8 @@ int main(int argc, char** argv) {
       });
   const bool journal_closed = !journal_writer.is_open() || journal_writer.close();
   if (!result.started) {
-    return fail(kExitNotStarted, result.error + ": " + link.last_error());
+    const std::string link_error = link.last_error();
+    return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));
   }
   const char* reason = control::safe_reason_name(result.safe_state);
   std::printf("stencil-rig: ran %.1f s, %llu cycles, %llu overruns, %llu periods skipped; wake-up p99 %.0f us, p99.9 %.0f us, "

@@ -109,7 +109,7 @@ int main(int argc, char** argv) {
                  "N x real time. 1: the cycle on a SCHED_FIFO thread at 1 kHz and the machine and the fake CY545 on "
                  "threads of their own, on the wall clock (what make latency measures); any other N: the --fast "
                  "virtual clock held to N simulated seconds per second, deterministic, so a person can watch")
-      ->check(CLI::PositiveNumber);
+      ->check(CLI::Range(1e-3, 1e6));
   app.add_option("--priority", priority, "real time: the cycle thread's SCHED_FIFO priority")
       ->check(CLI::Range(1, 99))
       ->capture_default_str();
@@ -277,6 +277,13 @@ int main(int argc, char** argv) {
     std::fclose(trace);
   }
   if (!result.started) {
+    // Nothing was run: what this run created for its outputs goes too.
+    if (!journal_path.empty()) {
+      std::remove(journal_path.c_str());
+    }
+    if (!trace_path.empty()) {
+      std::remove(trace_path.c_str());
+    }
     std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
     return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
   }
@@ -292,5 +299,6 @@ int main(int argc, char** argv) {
     return bad_input(error);
   }
   std::printf("report: %s\npicture: %s\n", report_path.c_str(), picture_path.c_str());
-  return result.safe_state == control::SafeReason::None ? kExitDone : kExitSafeState;
+  // A journal that lost records is not a job done, even if the cut itself ended well.
+  return result.safe_state == control::SafeReason::None && result.journal_error.empty() ? kExitDone : kExitSafeState;
 }

@@ -7,16 +7,26 @@
 namespace stencil::control {
 namespace {
 
+// The most cells along a side: 100 000 (5 m at 0.05 mm), so every count fits an int.
+constexpr double kMaxCellsAlong = 100'000.0;
+
 int cells_along(double low, double high, double cell) {
-  return static_cast<int>(std::ceil((high - low) / cell - 1e-9));
+  return static_cast<int>(std::clamp(std::ceil((high - low) / cell - 1e-9), 0.0, kMaxCellsAlong));
+}
+
+// floor(v) as a cell index clamped to [low, high] in double first, so no cast overflows.
+int index_clamped(double v, int low, int high) {
+  return static_cast<int>(std::clamp(std::floor(v), static_cast<double>(low), static_cast<double>(high)));
 }
 
 }  // namespace
 
 std::size_t CommandedStock::cells_needed(const StockBlock& block, double cell_mm) {
   if (!(cell_mm > 0.0) || !block.low_mm.allFinite() || !block.high_mm.allFinite() ||
-      !(block.high_mm.array() > block.low_mm.array()).all()) {
-    return 0;
+      !(block.high_mm.array() > block.low_mm.array()).all() ||
+      (block.high_mm.x() - block.low_mm.x()) / cell_mm > kMaxCellsAlong ||
+      (block.high_mm.y() - block.low_mm.y()) / cell_mm > kMaxCellsAlong) {
+    return 0;  // not a block, or too many cells to be one
   }
   return static_cast<std::size_t>(cells_along(block.low_mm.x(), block.high_mm.x(), cell_mm)) *
          static_cast<std::size_t>(cells_along(block.low_mm.y(), block.high_mm.y(), cell_mm));
@@ -56,10 +66,11 @@ double CommandedStock::lift(double radial) const {
 
 void CommandedStock::cut_at(const Eigen::Vector3d& tip) {
   const double x0 = block_.low_mm.x(), y0 = block_.low_mm.y();
-  const int c0 = std::max(0, static_cast<int>(std::floor((tip.x() - radius_mm_ - x0) / cell_mm_)));
-  const int c1 = std::min(columns_ - 1, static_cast<int>(std::floor((tip.x() + radius_mm_ - x0) / cell_mm_)));
-  const int r0 = std::max(0, static_cast<int>(std::floor((tip.y() - radius_mm_ - y0) / cell_mm_)));
-  const int r1 = std::min(rows_ - 1, static_cast<int>(std::floor((tip.y() + radius_mm_ - y0) / cell_mm_)));
+  // Clamped to the block: a footprint wholly outside it gives an empty range (c0 > c1 or r0 > r1).
+  const int c0 = index_clamped((tip.x() - radius_mm_ - x0) / cell_mm_, 0, columns_);
+  const int c1 = index_clamped((tip.x() + radius_mm_ - x0) / cell_mm_, -1, columns_ - 1);
+  const int r0 = index_clamped((tip.y() - radius_mm_ - y0) / cell_mm_, 0, rows_);
+  const int r1 = index_clamped((tip.y() + radius_mm_ - y0) / cell_mm_, -1, rows_ - 1);
   for (int row = r0; row <= r1; ++row) {
     const double dy = y0 + (row + 0.5) * cell_mm_ - tip.y();
     for (int column = c0; column <= c1; ++column) {
@@ -82,7 +93,7 @@ void CommandedStock::cut(const Eigen::Vector3d& from, const Eigen::Vector3d& to)
   // Points a cell apart: between two, a ball's surface rises by r - sqrt(r^2 - (cell/2)^2), a
   // fraction of a micrometre. A leg that starts where the last ended has its first point cut.
   const double length = (to - from).norm();
-  const int samples = std::clamp(static_cast<int>(std::ceil(length / cell_mm_)), 1, kMaxSamples);
+  const int samples = static_cast<int>(std::clamp(std::ceil(length / cell_mm_), 1.0, static_cast<double>(kMaxSamples)));
   for (int i = (have_last_ && from == last_end_) ? 1 : 0; i <= samples; ++i) {
     cut_at(from + (static_cast<double>(i) / samples) * (to - from));
   }

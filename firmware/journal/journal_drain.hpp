@@ -19,28 +19,35 @@ class JournalDrain {
     control::JournalRecord record{};
     while (ring.pop(record)) {
       if (writer_ != nullptr && !failed_ && !writer_->append(record)) {
-        fail();
+        failed_ = true;
       }
     }
+    tell_the_cycle();
   }
 
   void sync_if_due() {
     const auto now = std::chrono::steady_clock::now().time_since_epoch();
     if (writer_ != nullptr && !failed_ &&
         !writer_->sync_if_due(std::chrono::duration_cast<std::chrono::nanoseconds>(now).count())) {
-      fail();
+      failed_ = true;
     }
+    tell_the_cycle();
   }
 
+  [[nodiscard]] bool failed() const { return failed_; }
+
  private:
-  void fail() {
-    failed_ = true;
-    static_cast<void>(commands_.push({control::CommandKind::JournalFailed}));
+  // Until the cycle has the news: a full command ring is tried again at the next look.
+  void tell_the_cycle() {
+    if (failed_ && !told_) {
+      told_ = commands_.push({control::CommandKind::JournalFailed});
+    }
   }
 
   JournalWriter* writer_;
   control::CommandRing& commands_;
   bool failed_ = false;
+  bool told_ = false;
 };
 
 }  // namespace stencil::journal

@@ -6,6 +6,7 @@
 #include <iterator>
 #include <vector>
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include "firmware/control/safe_state.hpp"
@@ -52,7 +53,15 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
     crc = crc32(crc, data + offset, static_cast<uInt>(5 + length));
     ByteReader tail(payload + length, 4);
     if (tail.u32() != static_cast<std::uint32_t>(crc)) {
-      result.tail = at(offset) + "a record whose CRC-32 does not match";
+      const std::size_t after = left - (kRecordOverheadBytes + length);
+      if (after > 0) {
+        // A crash tears only the end: a bad record with more after it is damage, not a torn tail.
+        result.error = at(offset) + "a record whose CRC-32 does not match, with " + std::to_string(after) +
+                       " bytes after it (the journal is damaged, not cut short by a crash)";
+        result.good_bytes = offset;
+        return result;
+      }
+      result.tail = at(offset) + "a last record whose CRC-32 does not match";
       break;
     }
     ByteReader body(payload, length);
@@ -138,6 +147,12 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
 }
 
 JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) {
+    JournalReadResult result;
+    result.error = path + ": not a regular file (a journal is one)";
+    return result;
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     JournalReadResult result;

@@ -85,6 +85,15 @@ TEST(CommandedStock, ALongLegIsCutAlongAllOfItAndBadNumbersCutNothing) {
   DOUBLES_EQUAL(removed, model.stock.removed_volume_mm3(), 0.0);
 }
 
+TEST(CommandedStock, FarAwayOrHugeNumbersCutNothingAndAreNotCastOutOfRange) {
+  Model model(tool(CutterKind::Ball, 3.0));
+  model.stock.cut({5.0, 5.0, 1.0}, {1e300, 5.0, 1.0});  // a leg to almost infinity: bounded samples
+  model.stock.cut({1e12, -1e12, 1.0}, {1e12, -1e12, 1.0});
+  const double removed = model.stock.removed_volume_mm3();
+  CHECK(removed < 20.0 * 3.0 * 6.0);  // at most what the part of the leg inside the block can cut
+  LONGS_EQUAL(0, CommandedStock::cells_needed({{0, 0, 0}, {1e9, 1e9, 5}}, kCell));  // too many cells to be a block
+}
+
 TEST(CommandedStock, TooFewCellsOrAnEmptyBlockIsNotReady) {
   std::vector<float> few(10);
   const CommandedStock small(kBlock, kCell, tool(CutterKind::Ball, 3.0), few);

@@ -260,18 +260,20 @@ TEST(Controller, MoreThanThreeOverrunsInARowEnterTheSafeStateButThreeDoNot) {
 TEST(Controller, AStallThatSkipsPeriodsIsOneOverrunAndTheSkippedPeriodsAreCounted) {
   Bench bench;
   bench.cycles(20);
-  // The host stalls the cycle for 4.5 ms: the step due at `now` starts 4.5 ms late, and the runner
-  // skips the four periods that went by, so the next step is due at now + 5 ms.
+  // The host stalls the cycle for 4.5 ms: the step due at `now` starts 4.5 ms late; the runner
+  // skips the three periods that went by whole and runs the one under way (due at +4 ms) at once.
   for (int stall = 0; stall < 5; ++stall) {
     const hal::MonotonicNs due = bench.now;
     static_cast<void>(bench.controller->step(due + 4'500'000, due));
     bench.controller->finish(due + 4'600'000, due + kPeriodNs);
+    static_cast<void>(bench.controller->step(due + 4'600'000, due + 4 * kPeriodNs));  // late, not overrun
+    bench.controller->finish(due + 4'700'000, due + 5 * kPeriodNs);
     bench.now = due + 5 * kPeriodNs;
     bench.cycles(2);  // on time again
   }
   CHECK(bench.controller->safe_reason() == SafeReason::None);
   LONGS_EQUAL(5, bench.controller->statistics().overruns);
-  LONGS_EQUAL(20, bench.controller->statistics().missed_periods);
+  LONGS_EQUAL(15, bench.controller->statistics().missed_periods);
   CHECK(bench.controller->statistics().wakeup_latency.max_ns() >= 4'500'000);
 }
 

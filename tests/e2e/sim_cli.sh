@@ -314,6 +314,12 @@ case_rig_without_the_hardware_fails_cleanly() {
   run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --stock 0,0,0,50,25,abc
   expect_status 2
   expect_stderr "--stock 0,0,0,50,25,abc: expected X0,Y0,Z0,X1,Y1,Z1" "the stock and what it expects"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --stock 0,0,0,10000,25,5
+  expect_status 2
+  expect_stderr "inside the workspace \[0,50\]x\[0,25\]x\[0,25\]" "that the stock must fit the workspace"
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --tool-stick-out nan
+  expect_status 2
+  expect_stderr "--tool-stick-out and --reference-stick-out: expected a length in mm from 0 to 100" "the stick-out's range"
   run_rig --tables part.stbl --serial /dev/ttyS0 --haptic can:can0 --report /nonexistent/rig.json
   expect_status 2
   expect_stderr "/nonexistent/rig.json: cannot be written" "the report that cannot be written, before anything opens"

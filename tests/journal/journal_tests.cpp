@@ -10,6 +10,7 @@
 
 #include <unistd.h>
 
+#include "firmware/journal/journal_drain.hpp"
 #include "firmware/journal/journal_format.hpp"
 #include "firmware/journal/journal_reader.hpp"
 #include "firmware/journal/journal_writer.hpp"
@@ -184,20 +185,33 @@ TEST(Journal, ATornTailAtAnyByteIsIgnoredAndEverythingBeforeItReads) {
   }
 }
 
-TEST(Journal, AFlippedBitEndsTheReadAtThatRecordAndSaysWhere) {
+TEST(Journal, AFlippedBitWithRecordsAfterItIsDamageThatSaysWhereAndInTheLastRecordATornTail) {
   TempJournal file;
   write_job(file.path, 5);
-  std::vector<std::uint8_t> bytes = file.bytes();
+  const std::vector<std::uint8_t> whole = file.bytes();
+  const std::size_t record = kRecordOverheadBytes + kCyclePayloadBytes;
   const std::size_t start_record = kRecordOverheadBytes + 2 + 4 + 4 + 8 + std::string("journal_tests").size();
-  const std::size_t third = kFileHeaderBytes + start_record + 2 * (kRecordOverheadBytes + kCyclePayloadBytes);
+  const std::size_t third = kFileHeaderBytes + start_record + 2 * record;
+  std::vector<std::uint8_t> bytes = whole;
   bytes[third + 20] ^= 0x10;  // inside the third cycle record's payload
   Seen seen;
-  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
-  CHECK_TRUE(read.ok);
-  LONGS_EQUAL(2, seen.cycles.size());
+  JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
+  CHECK_FALSE(read.ok);
+  LONGS_EQUAL(2, seen.cycles.size());  // what came before it was read
   LONGS_EQUAL(third, read.good_bytes);
-  STRCMP_CONTAINS(("journal offset " + std::to_string(third) + ": a record whose CRC-32 does not match").c_str(),
-                  read.tail.c_str());
+  STRCMP_CONTAINS(("journal offset " + std::to_string(third) + ": a record whose CRC-32 does not match, with " +
+                   std::to_string(2 * record) + " bytes after it")
+                      .c_str(),
+                  read.error.c_str());
+  const std::size_t last = whole.size() - record;
+  bytes = whole;
+  bytes[last + 20] ^= 0x10;  // the last record: a torn write
+  Seen seen_last;
+  read = read_journal(bytes.data(), bytes.size(), seen_last.visitor());
+  CHECK_TRUE(read.ok);
+  LONGS_EQUAL(4, seen_last.cycles.size());
+  LONGS_EQUAL(record, read.tail_bytes);
+  STRCMP_CONTAINS("a last record whose CRC-32 does not match", read.tail.c_str());
 }
 
 TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
@@ -216,6 +230,9 @@ TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
   read = read_journal_file("/nonexistent/journal", seen.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());
+  read = read_journal_file("/dev/zero", seen.visitor());  // endless: refused before reading
+  CHECK_FALSE(read.ok);
+  STRCMP_EQUAL("/dev/zero: not a regular file (a journal is one)", read.error.c_str());
 }
 
 TEST(Journal, AFullDiskIsAFailureThatSaysSo) {
@@ -230,4 +247,29 @@ TEST(Journal, AFileThatCannotBeCreatedIsAFailureNamingIt) {
   JournalWriter writer;
   CHECK_FALSE(writer.open("/nonexistent/dir/job.journal", start_of()));
   STRCMP_EQUAL("/nonexistent/dir/job.journal: cannot be created: No such file or directory", writer.error().c_str());
+}
+
+// The journal thread's side: a record that cannot be written asks the cycle to stop, and a full
+// command ring does not lose that request.
+TEST(Journal, AWriteFailureReachesTheCycleEvenThroughAFullCommandRing) {
+  JournalWriter never_opened;  // every append fails
+  stencil::control::CommandRing commands;
+  stencil::control::JournalRing ring;
+  JournalDrain drain(&never_opened, commands);
+  while (commands.push({stencil::control::CommandKind::Reset})) {
+  }
+  CHECK(ring.push(record_of(0)));
+  drain.drain(ring);
+  CHECK_TRUE(drain.failed());
+  stencil::control::Command command{};
+  int journal_failed = 0;
+  while (commands.pop(command)) {  // the cycle takes its commands
+    journal_failed += command.kind == stencil::control::CommandKind::JournalFailed ? 1 : 0;
+  }
+  LONGS_EQUAL(0, journal_failed);  // there was no room
+  drain.drain(ring);               // the next look
+  CHECK(commands.pop(command));
+  CHECK(command.kind == stencil::control::CommandKind::JournalFailed);
+  drain.drain(ring);
+  CHECK_FALSE(commands.pop(command));  // once
 }
