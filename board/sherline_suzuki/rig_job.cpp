@@ -38,12 +38,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   const tables::PartTables& part = *job.part;
   const motion::MachineFrames frames = rig_frames(job.offset);
 
-  auto commands = std::make_unique<control::CommandRing>();
-  auto machine_events = std::make_unique<control::MachineEventRing>();
-  auto handoffs = std::make_unique<control::MachineHandoffRing>();
-  auto telemetry = std::make_unique<control::TelemetryRing>();
-  auto journal = std::make_unique<control::JournalRing>();
-  journal::JournalDrain records{job.journal, *commands};
+  auto rings = std::make_unique<control::CycleRingStorage>();
+  journal::JournalDrain records{job.journal, rings->commands};
 
   control::ControllerConfig config;
   config.frames = frames;
@@ -57,7 +53,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   auto controller = std::make_unique<control::Controller>(
-      part, *job.device, control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
+      part, *job.device, rings->rings(), config);
   if (!controller->ready()) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
@@ -66,7 +62,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
                                      1.0 / kRig.machine_update_hz,
                                      {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
                                       static_cast<std::int32_t>(backlash_steps(2))}};
-  auto machine = std::make_unique<control::MachineSide>(part, *job.machine, frames, limits, *handoffs, *machine_events);
+  auto machine = std::make_unique<control::MachineSide>(part, *job.machine, frames, limits, rings->machine, rings->machine_events);
   std::vector<float> model_cells(control::CommandedStock::cells_needed(job.stock, kModelCellMm));
   control::CommandedStock model(job.stock, kModelCellMm, part.tool.spec, model_cells);
   if (model.ready()) {
@@ -96,10 +92,10 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
     control::Telemetry last{};
     bool stop_sent = false;
     while (!stop.load()) {
-      records.drain(*journal);
+      records.drain(rings->journal);
       records.sync_if_due();
       control::Telemetry frame{};
-      while (telemetry->pop(frame)) {
+      while (rings->telemetry.pop(frame)) {
         if (job.progress && frame.safe_reason != last.safe_reason) {
           job.progress(frame.safe_reason == control::SafeReason::None
                            ? std::string("force restored; the mill stays stopped (re-homing to resume the cut is not built yet)")
@@ -113,7 +109,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
         last = frame;
       }
       if (!stop_sent && job.reset_requested && job.reset_requested()) {
-        static_cast<void>(commands->push({control::CommandKind::Reset}));
+        static_cast<void>(rings->commands.push({control::CommandKind::Reset}));
       }
       // The run ends through the cycle's own stop (this thread is the command ring's one producer):
       // on SIGINT/SIGTERM, or when the duration is up.
@@ -122,7 +118,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
                            static_cast<double>(clock.now_ns() - started) / 1e9 >= job.duration_s;
       if (!stop_sent && ((job.interrupted != nullptr && job.interrupted->load()) || time_up)) {
         stop_asked.store(true, std::memory_order_release);
-        stop_sent = commands->push({control::CommandKind::Stop});
+        stop_sent = rings->commands.push({control::CommandKind::Stop});
       }
       if (job.progress && std::chrono::steady_clock::now() >= next_progress) {
         char line[160];
@@ -164,7 +160,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   stop.store(true);
   machine_thread.join();
   records_thread.join();
-  records.drain(*journal);
+  records.drain(rings->journal);
   // The runner refused before the cycle ran (or the cycle never reached the machine side): the
   // machine is stopped here all the same.
   machine->shut_down(clock.now_ns() + 2 * kUpdateNs);

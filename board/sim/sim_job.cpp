@@ -257,12 +257,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   link_config.homing_rate = 20000;
   hal::cy545::Cy545Link link(port, machine_clock, link_config);
 
-  auto commands = std::make_unique<control::CommandRing>();
-  auto machine_events = std::make_unique<control::MachineEventRing>();
-  auto handoffs = std::make_unique<control::MachineHandoffRing>();
-  auto telemetry = std::make_unique<control::TelemetryRing>();
-  auto journal = std::make_unique<control::JournalRing>();
-  journal::JournalDrain records{job.journal, *commands};
+  auto rings = std::make_unique<control::CycleRingStorage>();
+  journal::JournalDrain records{job.journal, rings->commands};
   // The operator's hand, where the script starts, and the device it holds.
   stencil::sim::OperatorHand hand;
   hand.handle_mm = job.script.position_at(0.0);
@@ -282,13 +278,13 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   auto controller = std::make_unique<control::Controller>(
-      part, device.host(), control::CycleRings{*commands, *machine_events, *handoffs, *telemetry, *journal}, config);
+      part, device.host(), rings->rings(), config);
   if (!controller->ready()) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
   }
   const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
-  auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, *handoffs, *machine_events);
+  auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, rings->machine, rings->machine_events);
   // The controller's own model of the stock, from the targets it sends (cells allocated here, once).
   const control::StockBlock block{job.stock.low_mm, job.stock.high_mm};
   std::vector<float> model_cells(control::CommandedStock::cells_needed(block, kModelCellMm));
@@ -335,13 +331,13 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     });
     std::thread records_thread([&] {
       while (!stop.load()) {
-        records.drain(*journal);
+        records.drain(rings->journal);
         records.sync_if_due();
         control::Telemetry frame{};
-        while (telemetry->pop(frame)) {
+        while (rings->telemetry.pop(frame)) {
         }
         if (job.interrupted != nullptr && job.interrupted->load()) {
-          static_cast<void>(commands->push({control::CommandKind::Stop}));
+          static_cast<void>(rings->commands.push({control::CommandKind::Stop}));
         }
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
       }
@@ -381,7 +377,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     stop.store(true);
     machine_thread.join();
     records_thread.join();
-    records.drain(*journal);  // the last records, left after the records thread's last look
+    records.drain(rings->journal);  // the last records, left after the records thread's last look
     fake_runner.reset();
     if (!ran) {
       result.started = false;
@@ -417,9 +413,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
     controller->finish(cycle_ns, cycle_ns + kPeriodNs);
-    records.drain(*journal);
+    records.drain(rings->journal);
     control::Telemetry frame{};
-    while (telemetry->pop(frame)) {
+    while (rings->telemetry.pop(frame)) {
     }
     cycle_ns += kPeriodNs;
     if (status == control::CycleStatus::SafeState) {
@@ -436,7 +432,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     if (controller->statistics().cycles % 1000 == 0) {
       records.sync_if_due();
       if (job.interrupted != nullptr && job.interrupted->load()) {
-        static_cast<void>(commands->push({control::CommandKind::Stop}));  // taken by the next cycle
+        static_cast<void>(rings->commands.push({control::CommandKind::Stop}));  // taken by the next cycle
       }
       const double coverage = reachable_coverage(part, controller->touched());
       if (job.progress && t_s >= next_progress_s) {
@@ -453,7 +449,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       }
     }
   }
-  records.drain(*journal);
+  records.drain(rings->journal);
   machined.flush();
   return finish_result(result, part, *controller, *machine, model, machined, link, compute,
                        static_cast<double>(cycle_ns - start_ns) / 1e9, wall_start, mill, false);

@@ -109,4 +109,15 @@ struct CycleRings {
   JournalRing& journal;           // out: full is a fault
 };
 
+// The rings of one cycle, owned together: a board allocates one of these at start-up (they are
+// large: the journal ring alone holds seconds of records) and hands the cycle its rings().
+struct CycleRingStorage {
+  CommandRing commands;
+  MachineEventRing machine_events;
+  MachineHandoffRing machine;
+  TelemetryRing telemetry;
+  JournalRing journal;
+  [[nodiscard]] CycleRings rings() { return {commands, machine_events, machine, telemetry, journal}; }
+};
+
 }  // namespace stencil::control
