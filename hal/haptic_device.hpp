@@ -71,6 +71,7 @@ enum class HapticFault : std::uint8_t {
   NotOpen,                // no window / socket behind the backend
   SampleBusy,             // the device was mid-write on every attempt of the bounded retry (torn read)
   SampleOutOfRange,       // position or angle beyond the range, or beyond what the wire can carry
+  SampleNotFinite,        // a NaN or infinity in the position or angles (an in-process device; no wire carries one)
   BadFrame,               // wrong length / DLC, unknown ID, halves that disagree (CAN)
   CommandNotFinite,       // a NaN or infinity in the command
   DeviceHeartbeatLost,    // the device heartbeat did not move for the watchdog time: disconnected

@@ -9,6 +9,17 @@
 
 namespace stencil::hal {
 
+// True when every position and angle is a finite number.
+[[nodiscard]] inline bool sample_finite(const HapticSample& sample) {
+  for (const double v : sample.position_mm) {
+    if (!std::isfinite(v)) return false;
+  }
+  for (const double v : sample.angles_rad) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
 // True when every position and angle is finite and within the range.
 [[nodiscard]] inline bool sample_in_range(const HapticSample& sample, const HapticRange& range) {
   for (int axis = 0; axis < 3; ++axis) {

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -72,8 +73,9 @@ class SimulatedDeviceWiring {
  public:
   SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand, std::string& error)
       : transport_(transport), direct_(hal::kCornerOriginHapticRange) {
-    const auto pose = [&hand](std::uint32_t, hal::MonotonicNs) {
-      return stencil::sim::SimulatedPose{{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {0.0, 0.0}};
+    const auto pose = [&hand, this](std::uint32_t, hal::MonotonicNs) {
+      const Eigen::Vector3d at = disturbed(hand.handle_mm);
+      return stencil::sim::SimulatedPose{{at.x(), at.y(), at.z()}, {0.0, 0.0}};
     };
     if (transport == HapticTransport::Pio) {
       window_ = hal::pio_shared_memory::SharedWindowMapping::create_memfd("stencil-sim-pio", error);
@@ -106,12 +108,51 @@ class SimulatedDeviceWiring {
   // The device's millisecond: a new sample of the handle, the host's newest command taken.
   void device_cycle(const stencil::sim::OperatorHand& hand, const Eigen::Vector2d& angles, hal::MonotonicNs now_ns) {
     if (transport_ == HapticTransport::Direct) {
+      if (frozen_) {
+        return;
+      }
       ++counter_;
-      direct_.publish({{hand.handle_mm.x(), hand.handle_mm.y(), hand.handle_mm.z()}, {angles.x(), angles.y()}, counter_,
-                       hal::haptic_status::kForceApplied, counter_});
-      return;
+      const Eigen::Vector3d at = disturbed(hand.handle_mm);
+      direct_.publish({{at.x(), at.y(), at.z()}, {angles.x(), angles.y()}, counter_,
+                       hal::haptic_status::kForceApplied | (device_fault_ ? hal::haptic_status::kDeviceFault : 0U), counter_});
+    } else {
+      simulated_->step(now_ns);
     }
-    simulated_->step(now_ns);
+    jump_ = false;  // a jump is one sample
+  }
+
+  // The device's side of an injected fault.
+  void inject(FaultKind kind) {
+    switch (kind) {
+      case FaultKind::DeviceFrozen:
+        frozen_ = true;
+        if (simulated_ != nullptr) {
+          simulated_->set_frozen(true);
+        }
+        break;
+      case FaultKind::PoseNan:
+        nan_ = true;
+        break;
+      case FaultKind::PoseJump:
+        jump_ = true;
+        break;
+      case FaultKind::DeviceFault:
+        device_fault_ = true;
+        if (simulated_ != nullptr) {
+          simulated_->set_device_fault(true);
+        }
+        break;
+      default:
+        break;
+    }
+  }
+
+  // Zero force at the device: the command it drives (direct) or its own output (over a wire).
+  [[nodiscard]] bool force_off() const {
+    if (transport_ == HapticTransport::Direct) {
+      return !direct_.rendered().enable || rendered_force().norm() == 0.0;
+    }
+    return !simulated_->output().force_applied || rendered_force().norm() == 0.0;
   }
 
   [[nodiscard]] Eigen::Vector3d rendered_force() const {
@@ -133,6 +174,14 @@ class SimulatedDeviceWiring {
   std::unique_ptr<hal::pio_shared_memory::PioHapticDevice> pio_host_;
   std::unique_ptr<hal::socketcan::SocketCanHapticDevice> can_host_;
   hal::HapticDevice* host_ = nullptr;
+  bool frozen_ = false, nan_ = false, jump_ = false, device_fault_ = false;
+
+  [[nodiscard]] Eigen::Vector3d disturbed(const Eigen::Vector3d& handle) const {
+    if (nan_) {
+      return Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+    }
+    return jump_ ? Eigen::Vector3d(handle + Eigen::Vector3d(100.0, 0.0, 0.0)) : handle;
+  }
   std::unique_ptr<stencil::sim::SimulatedHapticDevice> simulated_;
   std::uint32_t counter_ = 0;
 };
@@ -166,6 +215,30 @@ std::function<double(double, double)> touch_tip_of(const tables::PartTables& par
 }
 
 namespace {
+
+// An injected fault where it happens: the device's side, or the far end of the serial line.
+void inject(FaultKind kind, SimulatedDeviceWiring& device, stencil::sim::cy545::FakeCy545& fake) {
+  switch (kind) {
+    case FaultKind::Cy545Silent:
+      fake.set_replies_suppressed(true);
+      break;
+    case FaultKind::Cy545Garbled:
+      fake.set_replies_garbled(true);
+      break;
+    case FaultKind::SerialGarbage:
+      fake.send_unsolicited("\x13Z#?\x7f 9\r\x05");
+      break;
+    case FaultKind::SerialClosed:
+      fake.close_pty();
+      break;
+    case FaultKind::PositionMismatch:
+      fake.set_reported_position_offset(100);
+      break;
+    default:
+      device.inject(kind);
+      break;
+  }
+}
 
 // The result of a job from its parts, once they have stopped.
 SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
@@ -400,6 +473,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       machine_clock.sleep_until_ns(cycle_ns);
       machine->update(machine_clock.now_ns() + 2 * kUpdateNs);
       machined.flush();
+      if (machine->state() == control::MachineSideState::Stopped && result.machine_stopped_s < 0.0) {
+        result.machine_stopped_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
+      }
       next_update_ns += kUpdateNs;
       if (stop_after_update) {
         break;
@@ -407,12 +483,23 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       continue;
     }
     const double t_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
+    if (job.fault.kind != FaultKind::None && result.fault_injected_s < 0.0 && t_s >= job.fault.at_s) {
+      inject(job.fault.kind, device, fake);
+      result.fault_kind = job.fault.kind;
+      result.fault_injected_s = t_s;
+    }
     hand.step(job.script.position_at(t_s), device.rendered_force());
     device.device_cycle(hand, job.script.angles_at(t_s), cycle_ns);
     const auto wall_before = std::chrono::steady_clock::now();
     const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
     controller->finish(cycle_ns, cycle_ns + kPeriodNs);
+    if (status == control::CycleStatus::SafeState && result.safe_state_s < 0.0) {
+      result.safe_state_s = t_s;
+    }
+    if (result.safe_state_s >= 0.0 && result.force_zero_s < 0.0 && device.force_off()) {
+      result.force_zero_s = t_s;  // what the device drives: the command it took this cycle
+    }
     records.drain(rings->journal);
     control::Telemetry frame{};
     while (rings->telemetry.pop(frame)) {
@@ -458,6 +545,35 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
 }  // namespace
 
 SimResult run_fast(const SimJob& job) { return run_job(job, nullptr); }
+
+namespace {
+constexpr std::pair<FaultKind, const char*> kFaultNames[] = {
+    {FaultKind::DeviceFrozen, "device-frozen"},   {FaultKind::PoseNan, "pose-nan"},
+    {FaultKind::PoseJump, "pose-jump"},           {FaultKind::DeviceFault, "device-fault"},
+    {FaultKind::Cy545Silent, "cy545-silent"},     {FaultKind::Cy545Garbled, "cy545-garbled"},
+    {FaultKind::SerialGarbage, "serial-garbage"}, {FaultKind::SerialClosed, "serial-closed"},
+    {FaultKind::PositionMismatch, "position-mismatch"},
+};
+}  // namespace
+
+const char* fault_kind_name(FaultKind kind) {
+  for (const auto& [k, name] : kFaultNames) {
+    if (k == kind) {
+      return name;
+    }
+  }
+  return "none";
+}
+
+bool parse_fault_kind(const std::string& name, FaultKind& kind) {
+  for (const auto& [k, n] : kFaultNames) {
+    if (name == n) {
+      kind = k;
+      return true;
+    }
+  }
+  return false;
+}
 
 SimResult run_realtime(const SimJob& job, const PeriodicRunner& runner) { return run_job(job, &runner); }
 

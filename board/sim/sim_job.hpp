@@ -37,6 +37,28 @@ inline constexpr double kOperatorSpeedMmPerS = 0.8;
 // memfd window (the PIO card's layout) or a socketpair carrying CAN frames.
 enum class HapticTransport : std::uint8_t { Direct, Pio, Can };
 
+// One fault injected mid-job (fast and paced runs): on the device's side, on the serial line, or in
+// the CY545's answers.
+enum class FaultKind : std::uint8_t {
+  None,
+  DeviceFrozen,      // the device stops: no sample, no heartbeat
+  PoseNan,           // its samples carry NaN positions from then on
+  PoseJump,          // one sample 100 mm off
+  DeviceFault,       // it reports its own fault (amplifier, encoder)
+  Cy545Silent,       // the CY545 stops answering (commands still run)
+  Cy545Garbled,      // its answers arrive with every byte's top bit flipped
+  SerialGarbage,     // bytes nobody asked for on the line
+  SerialClosed,      // the cable is pulled: the pty's master closes
+  PositionMismatch,  // the CY545 reports a position 100 steps off the one commanded
+};
+struct FaultInjection {
+  FaultKind kind = FaultKind::None;
+  double at_s = 0.0;  // simulated seconds from the start of the job
+};
+// "device-frozen", ... (the --inject names); parse_fault_kind gives false for an unknown name.
+[[nodiscard]] const char* fault_kind_name(FaultKind kind);
+[[nodiscard]] bool parse_fault_kind(const std::string& name, FaultKind& kind);
+
 struct SimJob {
   HapticTransport transport = HapticTransport::Direct;
   const tables::PartTables* part = nullptr;
@@ -48,6 +70,7 @@ struct SimJob {
   std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
   const std::atomic<bool>* interrupted = nullptr;  // set by SIGINT/SIGTERM: a stop command to the cycle
   journal::JournalWriter* journal = nullptr;  // every cycle's record goes here, when given (opened)
+  FaultInjection fault;  // run_fast only
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;
@@ -88,6 +111,12 @@ struct SimResult {
   control::SafeReason safe_state = control::SafeReason::None;
   std::string machine_error;  // the machine link's last error, when it faulted
   bool complete = false;  // until_complete met
+  // The injected fault and what followed, simulated seconds (negative: never happened).
+  FaultKind fault_kind = FaultKind::None;
+  double fault_injected_s = -1.0;
+  double safe_state_s = -1.0;       // the first cycle in the safe state
+  double force_zero_s = -1.0;       // from then, the first cycle the device drove no force
+  double machine_stopped_s = -1.0;  // the machine update that held and stopped the mill
   double model_removed_volume_mm3 = 0.0;  // the controller's own model of the stock (what it commanded)
   double model_max_difference_mm = 0.0;   // the most it differs from the mill's stock over any cell
   std::string journal_path;     // empty: no journal

@@ -22,6 +22,13 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
       {"cycles", r.cycles},
       {"overruns", r.overruns},
       {"missed_periods", r.missed_periods},
+      {"fault", r.fault_kind == FaultKind::None
+                    ? nlohmann::json(nullptr)
+                    : nlohmann::json{{"kind", fault_kind_name(r.fault_kind)},
+                                     {"injected_s", r.fault_injected_s},
+                                     {"safe_state_s", r.safe_state_s},
+                                     {"force_zero_s", r.force_zero_s},
+                                     {"machine_stopped_s", r.machine_stopped_s}}},
       {"stock_model",
        {{"removed_volume_mm3", r.model_removed_volume_mm3}, {"max_difference_mm", r.model_max_difference_mm}}},
       {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)

@@ -119,6 +119,13 @@ int main(int argc, char** argv) {
   app.add_flag("--until-complete", until_complete,
                "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
   app.add_option("--stock", stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the part's box grown by 2 mm)");
+  std::string inject_text;
+  board::sim::FaultInjection job_fault;
+  app.add_option("--inject", inject_text,
+                 "KIND@S: inject one fault S simulated seconds into the job (--fast or --speed N other than 1); KIND is "
+                 "device-frozen, pose-nan, pose-jump, device-fault, cy545-silent, cy545-garbled, serial-garbage, "
+                 "serial-closed or position-mismatch; the report's fault section says when the safe state, zero force "
+                 "and the stopped mill followed");
   std::string journal_path;
   app.add_option("--journal", journal_path,
                  "record the job here: every cycle's device sample and virtual tool, and every safe-state event, "
@@ -137,6 +144,19 @@ int main(int argc, char** argv) {
   if ((fast || (speed > 0.0 && speed != 1.0)) &&
       (app.count("--priority") + app.count("--cpu") + app.count("--require-rt")) > 0) {
     return bad_input("--priority, --cpu and --require-rt are for the real-time threads of --speed 1 only");
+  }
+  if (!inject_text.empty()) {
+    const std::size_t at = inject_text.find('@');
+    double at_s = 0.0;
+    if (at == std::string::npos || !board::sim::parse_fault_kind(inject_text.substr(0, at), job_fault.kind) ||
+        !sim::parse_finite_field(inject_text.substr(at + 1), at_s) || at_s < 0.0) {
+      return bad_input("--inject " + inject_text + ": expected KIND@SECONDS, KIND one of device-frozen, pose-nan, pose-jump, "
+                       "device-fault, cy545-silent, cy545-garbled, serial-garbage, serial-closed, position-mismatch");
+    }
+    job_fault.at_s = at_s;
+    if (speed == 1.0) {
+      return bad_input("--inject: faults are injected on the virtual clock (--fast or --speed N other than 1)");
+    }
   }
   if (fast == (speed > 0.0)) {
     return bad_input(fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)");
@@ -188,6 +208,7 @@ int main(int argc, char** argv) {
                   : transport == "can" ? board::sim::HapticTransport::Can
                                        : board::sim::HapticTransport::Direct;
   job.duration_s = duration_s;
+  job.fault = job_fault;
   job.until_complete = until_complete;
   std::FILE* trace = nullptr;
   if (!trace_path.empty()) {

@@ -116,6 +116,10 @@ bool Controller::read_device(hal::MonotonicNs now_ns) {
         enter_safe_state(SafeReason::PoseOutOfWorkspace);
         return false;
       }
+      if (read.reason == hal::HapticFault::SampleNotFinite) {
+        enter_safe_state(SafeReason::PoseNotFinite);
+        return false;
+      }
       break;
     case hal::ReadStatus::Fault:
       enter_safe_state(SafeReason::DeviceFault);
@@ -127,6 +131,10 @@ bool Controller::read_device(hal::MonotonicNs now_ns) {
       enter_safe_state(SafeReason::DeviceStale);
     }
     return have_sample_ && cycles_since_fresh_ <= config_.stale_periods;
+  }
+  if ((sample.status_bits & hal::haptic_status::kDeviceFault) != 0U) {
+    enter_safe_state(SafeReason::DeviceFault);  // the device's own fault: amplifier, encoder
+    return false;
   }
   const Eigen::Vector3d position = position_of(sample);
   if (!position.allFinite() || !std::isfinite(sample.angles_rad[0]) || !std::isfinite(sample.angles_rad[1])) {

@@ -23,6 +23,10 @@ class DirectHapticDevice final : public hal::HapticDevice {
       return {hal::ReadStatus::Stale, hal::HapticFault::None};
     }
     consumed_ = published_;
+    if (!hal::sample_finite(pending_)) {
+      ++counters_.samples_out_of_range;
+      return {hal::ReadStatus::Rejected, hal::HapticFault::SampleNotFinite};
+    }
     if (!hal::sample_in_range(pending_, range_)) {
       ++counters_.samples_out_of_range;
       return {hal::ReadStatus::Rejected, hal::HapticFault::SampleOutOfRange};

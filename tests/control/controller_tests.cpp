@@ -316,6 +316,22 @@ TEST(Controller, AStopCommandEntersTheSafeState) {
   check_safe(bench, SafeReason::Stopped);
 }
 
+TEST(Controller, TheDevicesOwnFaultFlagEntersTheSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.set_status_bits(hal::haptic_status::kForceApplied | hal::haptic_status::kDeviceFault);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::DeviceFault);
+}
+
+TEST(Controller, ASampleTheBackendFoundNotFiniteIsThePoseNotFiniteSafeState) {
+  Bench bench;
+  bench.cycles(20);
+  bench.device.give(hal::ReadStatus::Rejected, hal::HapticFault::SampleNotFinite);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::PoseNotFinite);
+}
+
 TEST(Controller, AJournalThatCannotBeWrittenEntersTheSafeStateWithItsOwnReason) {
   Bench bench;
   bench.cycles(20);

@@ -216,6 +216,65 @@ case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
     fail "job.journal is $size bytes; expected $((12 + 38 + 95 * cycles + 18)) ($cycles cycles and the safe-state event)"
 }
 
+# The fault-injection cases: a raster job, one fault 30 simulated seconds in. Each must end in the
+# named safe state (exit 3), within DETECT seconds of the fault; the device must drive no force
+# within one period of the safe state, the mill be held and stopped by the machine update after the
+# one under way (two updates: 67 ms), the journal hold the event, and nothing be gouged.
+# expect_fault KIND REASON DETECT [TRANSPORT]
+expect_fault() {
+  local kind=$1 reason=$2 detect=$3 transport=${4:-direct}
+  run_sim --fast --pattern raster --duration 60 --haptic-transport "$transport" --inject "$kind@30" --journal job.journal \
+    --report report.json
+  expect_status 3
+  grep -q "\"safe_state\": \"$reason\"" report.json || fail "$kind ended in $(grep '"safe_state"' report.json); expected $reason"
+  at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
+  local injected safe force stopped cycles size
+  injected=$(json_number report.json injected_s)
+  safe=$(json_number report.json safe_state_s)
+  force=$(json_number report.json force_zero_s)
+  stopped=$(json_number report.json machine_stopped_s)
+  awk -v i="$injected" -v s="$safe" -v d="$detect" 'BEGIN { exit !(s >= i && s - i <= d + 1e-9) }' ||
+    fail "$kind: the safe state came at $safe s for a fault at $injected s; expected within $detect s"
+  awk -v s="$safe" -v f="$force" 'BEGIN { exit !(f >= s && f - s <= 0.001 + 1e-9) }' ||
+    fail "$kind: no force at $force s, the safe state at $safe s; expected within one period"
+  awk -v s="$safe" -v m="$stopped" 'BEGIN { exit !(m >= 0 && m - s <= 0.067) }' ||
+    fail "$kind: the mill stopped at $stopped s, the safe state at $safe s; expected by the next machine update"
+  cycles=$(json_number report.json cycles)
+  size=$(stat -c %s job.journal)
+  [ "$size" -eq $((12 + 38 + 95 * cycles + 18)) ] ||
+    fail "$kind: job.journal is $size bytes; expected every cycle and the safe-state event ($((12 + 38 + 95 * cycles + 18)))"
+}
+
+case_fault_device_frozen() { expect_fault device-frozen device_stale 0.007; }
+case_fault_device_frozen_over_pio() { expect_fault device-frozen device_stale 0.007 pio; }
+case_fault_device_frozen_over_can() { expect_fault device-frozen device_stale 0.007 can; }
+case_fault_pose_nan() { expect_fault pose-nan pose_not_finite 0.001; }
+case_fault_pose_jump() { expect_fault pose-jump pose_jump 0.001; }
+case_fault_pose_jump_over_can() { expect_fault pose-jump pose_jump 0.001 can; }
+case_fault_device_fault_over_pio() { expect_fault device-fault device_fault 0.001 pio; }
+case_fault_cy545_silent() { expect_fault cy545-silent machine_fault 0.2; }
+case_fault_cy545_garbled() { expect_fault cy545-garbled machine_fault 0.2; }
+case_fault_serial_closed() { expect_fault serial-closed machine_fault 0.2; }
+case_fault_position_mismatch() { expect_fault position-mismatch machine_fault 0.2; }
+
+# Garbage on the serial line between exchanges: the driver flushes its input before each query,
+# so the bytes are dropped and the job goes on, ungouged.
+case_fault_serial_garbage_is_flushed() {
+  run_sim --fast --pattern raster --duration 60 --inject serial-garbage@30 --report report.json
+  expect_status 0
+  no_gouge
+  grep -q '"kind": "serial-garbage"' report.json || fail "the report does not name the injected fault"
+}
+
+case_refuses_a_bad_inject() {
+  run_sim --fast --pattern raster --inject lightning@3
+  expect_status 2
+  expect_stderr "--inject lightning@3: expected KIND@SECONDS, KIND one of device-frozen" "the option and its kinds"
+  run_sim --speed 1 --pattern raster --inject pose-nan@3
+  expect_status 2
+  expect_stderr "--inject: faults are injected on the virtual clock" "where faults can be injected"
+}
+
 case_refuses_a_bad_operator_csv() {
   printf 't_s,x_mm,y_mm,z_mm\n0,250,125,200\n0.5,250,abc,200\n' >operator.csv
   run_sim --fast --operator operator.csv --report report.json

@@ -26,6 +26,7 @@ class FakeHapticDevice final : public hal::HapticDevice {
     }
   }
   void fail_writes(bool fail) { fail_writes_ = fail; }
+  void set_status_bits(std::uint32_t bits) { sample_.status_bits = bits; }
   void connect(bool connected) { connected_ = connected; }
 
   hal::ReadResult read_sample(hal::MonotonicNs, hal::HapticSample& out) override {

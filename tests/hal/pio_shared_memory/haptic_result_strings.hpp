@@ -18,7 +18,7 @@ inline SimpleString StringFrom(WriteStatus status) {
 }
 inline SimpleString StringFrom(HapticFault fault) {
   constexpr const char* kNames[] = {"None",          "NotOpen",          "SampleBusy",
-                                    "SampleOutOfRange", "BadFrame",      "CommandNotFinite",
+                                    "SampleOutOfRange", "SampleNotFinite", "BadFrame",      "CommandNotFinite",
                                     "DeviceHeartbeatLost", "TransportError", "TransportFull"};
   return kNames[static_cast<int>(fault)];
 }
