@@ -266,6 +266,25 @@ case_fault_serial_garbage_is_flushed() {
   grep -q '"kind": "serial-garbage"' report.json || fail "the report does not name the injected fault"
 }
 
+# The journal's disk fills mid-cut (a 300 kB tmpfs: about three seconds of journal): the cut stops
+# in the safe state journal_failed and the report says why. Needs mount (root); skipped otherwise.
+case_fault_disk_full_for_the_journal() {
+  mkdir -p tiny
+  if ! mount -t tmpfs -o size=300k tmpfs tiny 2>/dev/null; then
+    echo "cannot mount a tmpfs here: skipped"
+    exit 77
+  fi
+  run_sim --fast --pattern raster --duration 20 --journal tiny/job.journal --report report.json
+  umount tiny
+  expect_status 3
+  grep -q '"safe_state": "journal_failed"' report.json || fail "the run ended in $(grep '"safe_state"' report.json); expected journal_failed"
+  grep -q 'tiny/job.journal: write failed: No space left on device' report.json ||
+    fail "the report does not say the journal's disk is full"
+  grep -q 'journal: tiny/job.journal: write failed: No space left on device' stdout.txt ||
+    fail "the summary does not say the journal's disk is full"
+  at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
+}
+
 case_refuses_a_bad_inject() {
   run_sim --fast --pattern raster --inject lightning@3
   expect_status 2
