@@ -76,6 +76,12 @@ bool parse_stock(const std::string& text, const tables::PartTables& part, sim::S
 }  // namespace
 
 int main(int argc, char** argv) {
+  // From the start: a signal while the job is being prepared still ends it through the cycle's
+  // stop, with its report and journal, once it runs.
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
   CLI::App app{
       "stencil-sim: the haptic stencil controller's cycle and machine side against a simulated operator and\n"
       "device, the fake CY545 stepper controller on a pseudo-terminal and a simulated mill that removes\n"
@@ -265,10 +271,6 @@ int main(int argc, char** argv) {
     job.journal = &journal_writer;
     std::printf("journal: %s\n", journal_path.c_str());
   }
-  struct sigaction action {};
-  action.sa_handler = on_signal;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
   job.interrupted = &interrupted;
   board::sim::SimResult result;
   if (fast || speed != 1.0) {

@@ -197,10 +197,14 @@ case_journal_holds_every_cycle() {
 # SIGTERM mid-cut: the run ends in the safe state "stopped" (exit 3) with its report and journal
 # written, the safe-state event in the journal (18 bytes after the cycles').
 case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
-  echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIGTERM after 3 s)"
+  echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIGTERM once cutting)"
   "$sim" --speed 10 --pattern raster --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
-  local pid=$!
-  sleep 3
+  local pid=$! waited=0
+  # Mid-cut: once the journal holds about a simulated second of cycles (slow builds take a while).
+  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt 100000 ] && [ "$waited" -lt 600 ]; do
+    sleep 0.1
+    waited=$((waited + 1))
+  done
   kill -TERM "$pid"
   wait "$pid"
   status=$?
