@@ -32,7 +32,7 @@ bench: build
 # triangle is touched; the report and its picture land in build/demo/.
 demo: build
 	mkdir -p build/demo
-	build/bin/stencil-sim --fast --pattern raster --until-complete --report build/demo/report.json
+	build/bin/stencil-sim --fast --pattern raster --until-complete --journal build/demo/job.journal --report build/demo/report.json
 
 test-asan: deps
 	cmake --preset asan

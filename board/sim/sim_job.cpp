@@ -28,6 +28,7 @@
 #include "sim/cy545/fake_cy545_runner.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/shared_window_mapping.hpp"
+#include "hal/socketcan/can_codec.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
 #include "sim/haptic_device/can_device_link.hpp"
@@ -45,11 +46,6 @@ constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
 constexpr double kBaud = 57600.0;
 constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
 
-motion::MachineFrames sim_frames() {
-  // Every axis counts into the workspace from its switch, so the world runs against all three.
-  return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
-          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), {-1, -1, -1}, 640.0};
-}
 
 Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
   return {histogram.quantile_us(0.5), histogram.quantile_us(0.99), histogram.quantile_us(0.999),
@@ -115,6 +111,9 @@ class SimulatedDeviceWiring {
       const Eigen::Vector3d at = disturbed(hand.handle_mm);
       direct_.publish({{at.x(), at.y(), at.z()}, {angles.x(), angles.y()}, counter_,
                        hal::haptic_status::kForceApplied | (device_fault_ ? hal::haptic_status::kDeviceFault : 0U), counter_});
+    } else if (bad_frames_left_ > 0) {
+      send_bad_frames(hand);
+      --bad_frames_left_;
     } else {
       simulated_->step(now_ns);
     }
@@ -135,6 +134,9 @@ class SimulatedDeviceWiring {
         break;
       case FaultKind::PoseJump:
         jump_ = true;
+        break;
+      case FaultKind::CanBadFrames:
+        bad_frames_left_ = 20;
         break;
       case FaultKind::DeviceFault:
         device_fault_ = true;
@@ -184,9 +186,37 @@ class SimulatedDeviceWiring {
   }
   std::unique_ptr<stencil::sim::SimulatedHapticDevice> simulated_;
   std::uint32_t counter_ = 0;
+  int bad_frames_left_ = 0;  // device milliseconds of bad frames still to send (CAN)
+  std::uint8_t bad_counter_ = 0;
+
+  // One millisecond of a babbling device: the pose with PoseA's DLC 5, then a PoseA and a PoseB
+  // whose counters disagree; no good pose gets through, and the status frame is not sent.
+  void send_bad_frames(const stencil::sim::OperatorHand& hand) {
+    hal::socketcan::PoseWire pose{};
+    pose.counter = ++bad_counter_;
+    for (int axis = 0; axis < 3; ++axis) {
+      pose.position_um[axis] = static_cast<std::int32_t>(std::lround(hand.handle_mm[axis] * 1e3));
+    }
+    can_frame a{}, b{};
+    if (!hal::socketcan::encode_pose(pose, a, b)) {
+      return;
+    }
+    can_frame short_a = a;
+    short_a.can_dlc = 5;
+    b.data[0] = static_cast<std::uint8_t>(b.data[0] + 1);
+    for (const can_frame& frame : {short_a, a, b}) {
+      static_cast<void>(device_channel_->send(frame));
+    }
+  }
 };
 
 }  // namespace
+
+motion::MachineFrames frames() {
+  // Every axis counts into the workspace from its switch, so the world runs against all three.
+  return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
+          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), {-1, -1, -1}, 640.0};
+}
 
 stencil::sim::StockBox default_stock(const tables::PartTables& part) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(1e300), high = Eigen::Vector3d::Constant(-1e300);
@@ -262,8 +292,9 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
   result.unmachined_volume_mm3 = volumes.unmachined_mm3;
   result.reachable_volume_mm3 = volumes.reachable_mm3;
   result.coverage_fraction = reachable_coverage(part, controller.touched());
-  result.max_force_n = controller.max_force_n();
-  result.max_offset_mm = controller.max_offset_mm();
+  // Over the whole job: a resumed one's journal says what the runs before this one reached.
+  result.max_force_n = std::max(controller.max_force_n(), result.earlier.max_force_n);
+  result.max_offset_mm = std::max(controller.max_offset_mm(), result.earlier.max_offset_mm);
   result.machine_updates = machine.statistics().updates;
   result.machine_take_ups = machine.statistics().take_ups;
   result.machine_max_lag_mm = machine.statistics().max_lag_mm;
@@ -304,7 +335,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   SimResult result;
   const tables::PartTables& part = *job.part;
   const auto wall_start = std::chrono::steady_clock::now();
-  const motion::MachineFrames frames = sim_frames();
+  const motion::MachineFrames frames = sim::frames();
 
   // The far side of the serial cable: the mill, its fake CY545 on a pty, the clock they follow.
   stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
@@ -363,6 +394,27 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   std::vector<float> model_cells(control::CommandedStock::cells_needed(block, kModelCellMm));
   control::CommandedStock model(block, kModelCellMm, part.tool.spec, model_cells);
   machine->keep_stock_model(&model);
+  std::unique_ptr<journal::MachineJournal> machine_journal;
+  if (job.journal != nullptr) {
+    machine_journal = std::make_unique<journal::MachineJournal>(*job.journal);
+    machine->record_to(machine_journal.get());
+  }
+  // A resumed job: what was touched and machined before, from the journal, before the machine homes.
+  if (!job.resume_from.empty()) {
+    const journal::HistoryRebuild rebuild{
+        [&](const Eigen::Vector3d& tip) { controller->recall_touched(tip); },
+        [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+          model.cut(from, to);
+          machined.cut_recorded_leg(from, to);
+        }};
+    std::string history_error;
+    if (!journal::read_job_history(job.resume_from, part.header.crc32, part.header.triangle_count, frames, rebuild,
+                                   result.earlier, history_error, job.resume_bytes)) {
+      result.error = "--resume: " + history_error;
+      return result;
+    }
+    result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
+  }
   // In real time the fake CY545 answers from a thread of its own; on virtual time it follows the
   // machine side's clock.
   std::unique_ptr<stencil::sim::cy545::FakeCy545Runner> fake_runner;
@@ -370,7 +422,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     fake_runner = std::make_unique<stencil::sim::cy545::FakeCy545Runner>(fake);
   }
   if (!machine->start(machine_clock.now_ns() + 120'000'000'000)) {
-    result.error = std::string("the machine did not start: ") + link.last_error();
+    result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
+                                            : std::string("the machine did not start: ") + link.last_error();
     return result;
   }
   result.started = true;
@@ -423,8 +476,10 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
             start_ns = deadline_ns;
           }
           const double t_s = static_cast<double>(now_ns - start_ns) / 1e9;
-          hand.step(job.script.position_at(t_s), device.rendered_force());
-          device.device_cycle(hand, job.script.angles_at(t_s), now_ns);
+          // After the job's duration the hand holds still where the script had got to.
+          const double script_s = std::min(t_s, duration_s);
+          hand.step(job.script.position_at(script_s), device.rendered_force());
+          device.device_cycle(hand, job.script.angles_at(script_s), now_ns);
           const control::CycleStatus status = controller->step(now_ns, deadline_ns);
           controller->finish(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns(), deadline_ns + kPeriodNs);
           if (status == control::CycleStatus::SafeState) {
@@ -485,16 +540,25 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const double t_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
     if (job.fault.kind != FaultKind::None && result.fault_injected_s < 0.0 && t_s >= job.fault.at_s) {
       inject(job.fault.kind, device, fake);
+      controller->set_count_overruns(job.fault.kind == FaultKind::OverrunStorm);
       result.fault_kind = job.fault.kind;
       result.fault_injected_s = t_s;
     }
-    hand.step(job.script.position_at(t_s), device.rendered_force());
-    device.device_cycle(hand, job.script.angles_at(t_s), cycle_ns);
+    // After the job's duration the hand holds still where the script had got to, while the mill
+    // catches up: the same job always ends at the same place.
+    const double script_s = std::min(t_s, duration_s);
+    hand.step(job.script.position_at(script_s), device.rendered_force());
+    device.device_cycle(hand, job.script.angles_at(script_s), cycle_ns);
     const auto wall_before = std::chrono::steady_clock::now();
-    const control::CycleStatus status = controller->step(cycle_ns, cycle_ns);
+    // An overrun storm: from the injection on, every cycle starts and ends 1.5 periods late, as on a
+    // host that stalls the thread (lateness counts then, as on the wall clock).
+    const hal::MonotonicNs late_ns = result.fault_kind == FaultKind::OverrunStorm ? 3 * kPeriodNs / 2 : 0;
+    const control::CycleStatus status = controller->step(cycle_ns + late_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
-    controller->finish(cycle_ns, cycle_ns + kPeriodNs);
-    if (status == control::CycleStatus::SafeState && result.safe_state_s < 0.0) {
+    controller->finish(cycle_ns + late_ns, cycle_ns + kPeriodNs);
+    // The overrun watchdog may enter the safe state in finish(): it counts from this cycle.
+    const bool safe = status == control::CycleStatus::SafeState || controller->safe_reason() != control::SafeReason::None;
+    if (safe && result.safe_state_s < 0.0) {
       result.safe_state_s = t_s;
     }
     if (result.safe_state_s >= 0.0 && result.force_zero_s < 0.0 && device.force_off()) {
@@ -505,7 +569,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     while (rings->telemetry.pop(frame)) {
     }
     cycle_ns += kPeriodNs;
-    if (status == control::CycleStatus::SafeState) {
+    if (safe) {
       stop_after_update = true;  // one more machine update: it holds and stops the mill
       next_update_ns = std::min(next_update_ns, cycle_ns);
       continue;
@@ -552,7 +616,8 @@ constexpr std::pair<FaultKind, const char*> kFaultNames[] = {
     {FaultKind::PoseJump, "pose-jump"},           {FaultKind::DeviceFault, "device-fault"},
     {FaultKind::Cy545Silent, "cy545-silent"},     {FaultKind::Cy545Garbled, "cy545-garbled"},
     {FaultKind::SerialGarbage, "serial-garbage"}, {FaultKind::SerialClosed, "serial-closed"},
-    {FaultKind::PositionMismatch, "position-mismatch"},
+    {FaultKind::PositionMismatch, "position-mismatch"}, {FaultKind::CanBadFrames, "can-bad-frames"},
+    {FaultKind::OverrunStorm, "overrun-storm"},
 };
 }  // namespace
 

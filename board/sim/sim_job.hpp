@@ -14,6 +14,8 @@
 #include <Eigen/Core>
 
 #include "firmware/control/safe_state.hpp"
+#include "firmware/journal/job_history.hpp"
+#include "firmware/motion/machine_frames.hpp"
 #include "firmware/journal/journal_writer.hpp"
 #include "firmware/tables/part_tables.hpp"
 #include "hal/clock.hpp"
@@ -50,6 +52,8 @@ enum class FaultKind : std::uint8_t {
   SerialGarbage,     // bytes nobody asked for on the line
   SerialClosed,      // the cable is pulled: the pty's master closes
   PositionMismatch,  // the CY545 reports a position 100 steps off the one commanded
+  CanBadFrames,      // over CAN, 20 ms of bad frames instead of the device's: a wrong DLC, halves whose counters disagree
+  OverrunStorm,      // the cycle starts 1.5 periods late, every period from then on (a stalled host)
 };
 struct FaultInjection {
   FaultKind kind = FaultKind::None;
@@ -69,7 +73,12 @@ struct SimJob {
   std::FILE* trace = nullptr;   // the mill's true path corners, t_s,x_mm,y_mm,z_mm
   std::function<void(double simulated_s, double coverage)> progress;  // about every 10 simulated s
   const std::atomic<bool>* interrupted = nullptr;  // set by SIGINT/SIGTERM: a stop command to the cycle
-  journal::JournalWriter* journal = nullptr;  // every cycle's record goes here, when given (opened)
+  journal::JournalWriter* journal = nullptr;  // every cycle's record and machine command goes here, when given (opened)
+  // A resumed job: the journal of the job so far, read before the machine homes; the touched set and
+  // the stock as machined are rebuilt from it and the result covers the whole job (`journal` then
+  // carries on in the same file, opened to resume).
+  std::string resume_from;
+  std::size_t resume_bytes = 0;  // how much of it the job so far is (the file grows as this run carries on)
   FaultInjection fault;  // run_fast only
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
@@ -121,7 +130,12 @@ struct SimResult {
   double model_max_difference_mm = 0.0;   // the most it differs from the mill's stock over any cell
   std::string journal_path;     // empty: no journal
   std::uint64_t journal_records = 0;
+  std::uint64_t journal_machine_records = 0;
   std::string journal_error;    // why the journal stopped, when it could not be written
+  // The job before this run, from the journal it resumed (earlier.segments 0: a fresh job), and the
+  // touched set's size the journal recorded against the one rebuilt from its virtual tool.
+  journal::JobHistory earlier;
+  std::uint32_t touched_rebuilt = 0;
   // The machined stock, the part's top and what is left to cut, for the picture: heights per cell, row-major.
   int columns = 0, rows = 0;
   double cell_mm = 0.0;
@@ -142,6 +156,9 @@ struct SimResult {
 // part's top over a 0.05 mm grid of the stock (the scripted operator's idea of the part).
 [[nodiscard]] std::function<double(double, double)> touch_tip_of(const tables::PartTables& part,
                                                                   const stencil::sim::StockBox& stock);
+
+// The simulation board's device -> world -> machine frames (above).
+[[nodiscard]] motion::MachineFrames frames();
 
 // The default stock for a part: its bounding box grown by 2 mm on each side in x and y (within the
 // workspace), from the floor to 1 mm above the part's top.

@@ -15,10 +15,50 @@ nlohmann::json quantiles_json(const Quantiles& q) {
   return {{"p50", q.p50}, {"p99", q.p99}, {"p999", q.p999}, {"max", q.max}};
 }
 
+// The whole job, over every run its journal recorded and this one: a fresh job is one run.
+nlohmann::json job_json(const SimResult& r) {
+  nlohmann::json safe_states = nlohmann::json::array();
+  for (const journal::RecordedFault& fault : r.earlier.faults) {
+    safe_states.push_back({{"run", fault.segment}, {"cycle", fault.cycle}, {"reason", control::safe_reason_name(fault.reason)}});
+  }
+  if (r.safe_state != control::SafeReason::None) {
+    safe_states.push_back({{"run", r.earlier.segments}, {"cycle", r.cycles}, {"reason", control::safe_reason_name(r.safe_state)}});
+  }
+  return {{"runs", r.earlier.segments + 1},
+          {"total_cycles", r.earlier.cycles + r.cycles},
+          {"total_simulated_s", r.earlier.recorded_s + r.simulated_s},
+          {"earlier_machine_commands", r.earlier.machine_commands},
+          {"earlier_machined_legs", r.earlier.machined_legs},
+          {"touched_recorded", r.earlier.touched_recorded},
+          {"touched_rebuilt", r.touched_rebuilt},
+          {"safe_states", safe_states}};
+}
+
 }  // namespace
+
+bool write_stock_csv(const std::string& path, const SimResult& r, std::string& error) {
+  std::FILE* out = std::fopen(path.c_str(), "w");
+  if (out == nullptr) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  for (int row = 0; row < r.rows; ++row) {
+    for (int column = 0; column < r.columns; ++column) {
+      std::fprintf(out, column == 0 ? "%.5f" : ",%.5f",
+                   r.stock_heights[static_cast<std::size_t>(row) * static_cast<std::size_t>(r.columns) + static_cast<std::size_t>(column)]);
+    }
+    std::fputc('\n', out);
+  }
+  if (std::fclose(out) != 0) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  return true;
+}
 
 bool write_report_json(const std::string& path, const SimResult& r, std::string& error) {
   nlohmann::json report = {
+      {"job", job_json(r)},
       {"cycles", r.cycles},
       {"overruns", r.overruns},
       {"missed_periods", r.missed_periods},
@@ -34,6 +74,7 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
       {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)
                                          : nlohmann::json{{"path", r.journal_path},
                                                           {"cycle_records", r.journal_records},
+                                                          {"machine_records", r.journal_machine_records},
                                                           {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
                                                                                             : nlohmann::json(r.journal_error)}}},
       {"simulated_s", r.simulated_s},

@@ -11,6 +11,9 @@ namespace stencil::board::sim {
 // Writes the report as JSON; false with `error` naming the path on failure.
 [[nodiscard]] bool write_report_json(const std::string& path, const SimResult& result, std::string& error);
 
+// The machined stock's heights as CSV, one Z-map row per line (y rising), mm.
+[[nodiscard]] bool write_stock_csv(const std::string& path, const SimResult& result, std::string& error);
+
 // A few lines for the terminal.
 [[nodiscard]] std::string summary(const SimResult& result);
 

@@ -1,7 +1,9 @@
 // stencil-sim: the controller's cycle and machine side against the simulated device, the fake CY545
 // on a pseudo-terminal and the simulated mill, on the baked-in sample part or a table file; reports
 // gouges, coverage and loop timing.
+#include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <iostream>
@@ -130,12 +132,27 @@ int main(int argc, char** argv) {
   app.add_option("--inject", inject_text,
                  "KIND@S: inject one fault S simulated seconds into the job (--fast or --speed N other than 1); KIND is "
                  "device-frozen, pose-nan, pose-jump, device-fault, cy545-silent, cy545-garbled, serial-garbage, "
-                 "serial-closed or position-mismatch; the report's fault section says when the safe state, zero force "
+                 "serial-closed, position-mismatch, can-bad-frames (needs --haptic-transport can) or overrun-storm; the report's fault section says when the safe state, zero force "
                  "and the stopped mill followed");
   std::string journal_path;
+  bool no_journal = false;
+  std::string resume_path;
+  std::string stock_csv_path;
   app.add_option("--journal", journal_path,
-                 "record the job here: every cycle's device sample and virtual tool, and every safe-state event, "
-                 "with a CRC-32 each, synced to the disk every second and at once on a safe state (default: none)");
+                 "record the job here: every cycle's device sample, virtual tool and force, every machine command "
+                 "(written before it is sent) and every safe-state event, with a CRC-32 each, synced to the disk every "
+                 "second and at once on a safe state (default: stencil-sim-YYYYMMDD-HHMMSS.journal in the current "
+                 "folder, named after the start time; about 400 MB per simulated hour)");
+  app.add_flag("--no-journal", no_journal, "record no journal (the job cannot be resumed)");
+  app.add_option("--resume", resume_path,
+                 "carry on the job this journal recorded (after a crash, a kill or a safe state), given the same "
+                 "--tables, --pattern, --seed, --operator and --stock: the touched set and the stock as machined are "
+                 "rebuilt from it, the machine homes again, the simulated operator goes back across at home's height "
+                 "and down to where the cut stopped and carries on with its script; the journal carries on in the "
+                 "same file and the report covers the whole job (--duration is then the whole job's)");
+  app.add_option("--stock-csv", stock_csv_path,
+                 "write the machined stock's heights here at the end: one row of the Z-map per line (y rising), "
+                 "mm, cells of 0.05 mm from the stock's low corner");
   app.add_option("--trace", trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
   app.add_option("--haptic-transport", transport,
                  "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
@@ -157,12 +174,22 @@ int main(int argc, char** argv) {
     if (at == std::string::npos || !board::sim::parse_fault_kind(inject_text.substr(0, at), job_fault.kind) ||
         !sim::parse_finite_field(inject_text.substr(at + 1), at_s) || at_s < 0.0) {
       return bad_input("--inject " + inject_text + ": expected KIND@SECONDS, KIND one of device-frozen, pose-nan, pose-jump, "
-                       "device-fault, cy545-silent, cy545-garbled, serial-garbage, serial-closed, position-mismatch");
+                       "device-fault, cy545-silent, cy545-garbled, serial-garbage, serial-closed, position-mismatch, "
+                       "can-bad-frames, overrun-storm");
     }
     job_fault.at_s = at_s;
+    if (job_fault.kind == board::sim::FaultKind::CanBadFrames && transport != "can") {
+      return bad_input("--inject can-bad-frames: the bad frames are CAN frames (--haptic-transport can)");
+    }
     if (speed == 1.0) {
       return bad_input("--inject: faults are injected on the virtual clock (--fast or --speed N other than 1)");
     }
+  }
+  if (!resume_path.empty() && (!journal_path.empty() || no_journal)) {
+    return bad_input("--resume carries on in the journal it resumes: no --journal or --no-journal with it");
+  }
+  if (no_journal && !journal_path.empty()) {
+    return bad_input("--journal and --no-journal: choose one");
   }
   if (fast == (speed > 0.0)) {
     return bad_input(fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)");
@@ -209,6 +236,47 @@ int main(int argc, char** argv) {
                                                               : sim::Pattern::Random;
     job.script = sim::make_pattern(pattern, job.stock, home, board::sim::kOperatorSpeedMmPerS,
                                    board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock));
+  }
+  // What makes the job the same job when it is resumed: recorded at its start, checked on resume.
+  char job_text[400];
+  std::snprintf(job_text, sizeof job_text, "tables=%s operator=%s pattern=%s seed=%llu stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
+                tables_path.empty() ? "(baked-in hex prism)" : tables_path.c_str(),
+                operator_path.empty() ? "-" : operator_path.c_str(), operator_path.empty() ? pattern_name.c_str() : "-",
+                static_cast<unsigned long long>(seed), job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z(),
+                job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
+  journal::JobHistory history;
+  journal::JournalResume resume;
+  if (!resume_path.empty()) {
+    // A first look at the journal: is it this job, and where did it stop? The rebuild is the job's.
+    if (!journal::read_job_history(resume_path, part.header.crc32, part.header.triangle_count,
+                                   board::sim::frames(), {}, history, error)) {
+      return bad_input("--resume: " + error);
+    }
+    if (history.start.job != job_text) {
+      return bad_input("--resume " + resume_path + ": recorded for another job (" + history.start.job +
+                       "); this one is " + job_text + ": resume with the recorded job's options");
+    }
+    if (!history.tail.empty()) {
+      std::printf("resume: %s: ignoring its torn tail (%s)\n", resume_path.c_str(), history.tail.c_str());
+    }
+    // Where the cut stopped: the mill's last target (the stock is cut there), else the virtual tool.
+    const Eigen::Vector3d rejoin = history.machine_commands > 0 ? history.last_commanded_tip_mm : history.last_virtual_tip_mm;
+    double approach_s = 0.0;
+    job.script = sim::carry_on(job.script, history.script_s, home, rejoin, board::sim::kOperatorSpeedMmPerS,
+                               board::sim::kDeviceMmPerWorldMm, approach_s);
+    resume.segment = history.segments;
+    resume.script_s = history.script_s;
+    resume.approach_s = approach_s;
+    if (duration_s > 0.0) {
+      duration_s = approach_s + std::max(0.0, duration_s - history.script_s);
+    }
+    std::printf("resume: %s: %u run(s), %llu cycles, %zu safe state(s), %llu machine commands; the script carries on "
+                "from %.3f s after %.1f s back to (%.3f, %.3f, %.3f) mm\n",
+                resume_path.c_str(), history.segments, static_cast<unsigned long long>(history.cycles),
+                history.faults.size(), static_cast<unsigned long long>(history.machine_commands), history.script_s,
+                approach_s, rejoin.x(), rejoin.y(), rejoin.z());
+    job.resume_from = resume_path;
+    job.resume_bytes = history.good_bytes;
   }
   job.transport = transport == "pio"   ? board::sim::HapticTransport::Pio
                   : transport == "can" ? board::sim::HapticTransport::Can
@@ -257,14 +325,32 @@ int main(int argc, char** argv) {
     }
   }
   journal::JournalWriter journal_writer;
-  if (!journal_path.empty()) {
+  const auto now = std::chrono::system_clock::now();
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+  if (!resume_path.empty()) {
+    resume.unix_time_ns = now_ns;
+    resume.program = "stencil-sim";
+    if (!journal_writer.open_to_resume(resume_path, history.good_bytes, resume)) {
+      return bad_input(journal_writer.error());
+    }
+    journal_path = resume_path;
+    job.journal = &journal_writer;
+    std::printf("journal: %s (carried on)\n", journal_path.c_str());
+  } else if (!no_journal) {
+    if (journal_path.empty()) {
+      const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+      std::tm local{};
+      localtime_r(&seconds, &local);
+      char name[64];
+      std::strftime(name, sizeof name, "stencil-sim-%Y%m%d-%H%M%S.journal", &local);
+      journal_path = name;
+    }
     journal::JournalStart start;
     start.tables_crc32 = part.header.crc32;
     start.triangle_count = part.header.triangle_count;
-    start.unix_time_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(
-                             std::chrono::system_clock::now().time_since_epoch())
-                             .count();
+    start.unix_time_ns = now_ns;
     start.program = "stencil-sim";
+    start.job = job_text;
     if (!journal_writer.open(journal_path, start)) {
       return bad_input(journal_writer.error());
     }
@@ -303,8 +389,8 @@ int main(int argc, char** argv) {
     std::fclose(trace);
   }
   if (!result.started) {
-    // Nothing was run: what this run created for its outputs goes too.
-    if (!journal_path.empty()) {
+    // Nothing was run: what this run created for its outputs goes too (a resumed journal stays).
+    if (!journal_path.empty() && resume_path.empty()) {
       std::remove(journal_path.c_str());
     }
     if (!trace_path.empty()) {
@@ -317,11 +403,15 @@ int main(int argc, char** argv) {
     const bool closed = journal_writer.close();
     result.journal_path = journal_path;
     result.journal_records = journal_writer.cycle_records();
+    result.journal_machine_records = journal_writer.machine_records();
     result.journal_error = closed ? "" : journal_writer.error();
   }
   std::printf("%s", board::sim::summary(result).c_str());
   if (!board::sim::write_report_json(report_path, result, error) ||
       !board::sim::write_picture_svg(picture_path, result, error)) {
+    return bad_input(error);
+  }
+  if (!stock_csv_path.empty() && !board::sim::write_stock_csv(stock_csv_path, result, error)) {
     return bad_input(error);
   }
   std::printf("report: %s\npicture: %s\n", report_path.c_str(), picture_path.c_str());

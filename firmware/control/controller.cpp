@@ -96,8 +96,15 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
     }
     if (event.kind == MachineEventKind::Fault) {
       enter_safe_state(SafeReason::MachineFault);
+    } else if (event.kind == MachineEventKind::JournalFailed) {
+      enter_safe_state(SafeReason::JournalFailed);
     }
   }
+}
+
+void Controller::recall_touched(const Eigen::Vector3d& tip_mm) {
+  static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip_mm, Eigen::Vector3d::UnitZ()},
+                                         config_.contact_tolerance_mm, touched_));
 }
 
 bool Controller::read_device(hal::MonotonicNs now_ns) {
@@ -243,6 +250,10 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   record.fresh = fresh_;
   copy3(tool_.tip_mm(), record.virtual_tip_mm);
   record.safe_reason = safe_reason_;  // as it stands before the machine handoff below
+  record.touched_triangles = static_cast<std::uint32_t>(touched_.count());
+  for (int i = 0; i < 3; ++i) {
+    record.force_n[i] = static_cast<float>(last_command_.force_n[i]);
+  }
   if (!rings_.journal.push(record)) {
     enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
   }

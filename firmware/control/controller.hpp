@@ -81,6 +81,14 @@ class Controller {
   // overrun watchdog (which may enter the safe state, writing zero force at once). Real-time safe.
   void finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns);
 
+  // Init time, before the first step(), never from the cycle: a resumed job's touched set, rebuilt
+  // from the virtual tool's tips its journal recorded, in order (the cycle marks the same way).
+  void recall_touched(const Eigen::Vector3d& tip_mm);
+
+  // Whether lateness counts (ControllerConfig::count_overruns), switched by the cycle's own thread:
+  // the simulation turns it on to inject a stalled host on its virtual clock.
+  void set_count_overruns(bool on) { config_.count_overruns = on; }
+
   [[nodiscard]] SafeReason safe_reason() const { return safe_reason_; }
   [[nodiscard]] ResetOutcome last_reset() const { return last_reset_; }
   [[nodiscard]] const LoopStatistics& statistics() const { return statistics_; }

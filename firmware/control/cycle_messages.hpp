@@ -58,6 +58,7 @@ struct MachineHandoff {
 enum class MachineEventKind : std::uint8_t {
   Fault,    // the link latched a fault: the cycle enters the safe state
   Stopped,  // the machine is stopped (after a safe state): for the record
+  JournalFailed,  // a target could not be recorded, so it was not sent: the cycle enters the safe state
 };
 
 struct MachineEvent {
@@ -91,6 +92,8 @@ struct JournalRecord {
   bool fresh;                // a new sample this cycle
   double virtual_tip_mm[3];
   SafeReason safe_reason;    // as latched at the end of the cycle
+  std::uint32_t touched_triangles;  // the touched set's size after the cycle: progress, and a check on a rebuild
+  float force_n[3];          // as written to the device
 };
 
 // The rings around the cycle: capacities in the types. The machine side drains its ring at each

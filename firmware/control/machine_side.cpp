@@ -14,17 +14,21 @@ bool MachineSide::start(hal::MonotonicNs deadline_ns) {
   if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
     return false;
   }
+  // Homed: the tool is at home whatever the record said before (a resumed job starts here).
+  if (recorder_ != nullptr && !recorder_->homed(deadline_ns)) {
+    record_failed_ = true;
+    return false;
+  }
   planner_.homed({{0, 0, 0}}, link_.home_approach());
   moves_seen_ = link_.status().moves_done;
   state_ = MachineSideState::Cutting;
   return true;
 }
 
-void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault) {
+void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineEventKind report) {
   if (report_fault) {
     // A full event ring means the cycle already has a fault to read: it is in its safe state.
-    static_cast<void>(
-        to_cycle_.push({MachineEventKind::Fault, static_cast<std::uint8_t>(link_.status().fault)}));
+    static_cast<void>(to_cycle_.push({report, static_cast<std::uint8_t>(link_.status().fault)}));
   }
   if (state_ == MachineSideState::Stopped) {
     return;
@@ -67,6 +71,19 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   switch (plan.status) {
     case motion::PlanStatus::Moved:
     case motion::PlanStatus::TakingUp: {
+      if (recorder_ != nullptr) {
+        MachineCommandRecord record{statistics_.updates, update_deadline_ns, {}, {3, 3, 3}, {}};
+        for (int i = 0; i < 3; ++i) {
+          record.motor_target[i] = plan.motor_target.axis[static_cast<std::size_t>(i)];
+          record.order[i] = plan.order[static_cast<std::size_t>(i)];
+          record.target_tip_mm[i] = plan.target_mm[i];
+        }
+        if (!recorder_->command(record)) {
+          record_failed_ = true;  // not recorded: not sent either, so the record still holds all that was cut
+          stop(update_deadline_ns, true, MachineEventKind::JournalFailed);
+          return;
+        }
+      }
       const hal::MachineResult moved = link_.move({plan.motor_target.axis, plan.order, true}, update_deadline_ns);
       if (!moved.done) {
         stop(update_deadline_ns, true);

@@ -8,6 +8,7 @@
 
 #include "firmware/control/commanded_stock.hpp"
 #include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/machine_record.hpp"
 #include "firmware/motion/machine_planner.hpp"
 #include "hal/clock.hpp"  // MonotonicNs
 #include "hal/machine_link.hpp"
@@ -62,11 +63,16 @@ class MachineSide {
   // before start(); this side is its only writer, readers look once the machine thread is done or
   // between updates on the same thread.
   void keep_stock_model(CommandedStock* stock) { stock_ = stock; }
+  // Every homing and target goes to `recorder` before it is acted on (null: none). Set before start().
+  void record_to(MachineRecorder* recorder) { recorder_ = recorder; }
+  // The recorder refused a record: the machine did not start, or was stopped and the cycle told.
+  [[nodiscard]] bool record_failed() const { return record_failed_; }
   // Where the last target sent puts the tool tip (world mm): home until the first.
   [[nodiscard]] const Eigen::Vector3d& commanded_tip_mm() const { return commanded_tip_mm_; }
 
  private:
-  void stop(hal::MonotonicNs deadline_ns, bool report_fault);
+  // report: the event the cycle gets first (Fault, JournalFailed), or nothing when it stopped us.
+  void stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineEventKind report = MachineEventKind::Fault);
 
   hal::MachineLink& link_;
   MachineHandoffRing& from_cycle_;
@@ -77,6 +83,8 @@ class MachineSide {
   bool at_goal_ = false;
   MachineSideStatistics statistics_;
   CommandedStock* stock_ = nullptr;
+  MachineRecorder* recorder_ = nullptr;
+  bool record_failed_ = false;
   Eigen::Vector3d commanded_tip_mm_;
 };
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/machine_record.hpp"
 
 namespace stencil::journal {
 
@@ -18,6 +19,12 @@ class ByteWriter {
   void u32(std::uint32_t v) { little(v, 4); }
   void u64(std::uint64_t v) { little(v, 8); }
   void i64(std::int64_t v) { little(static_cast<std::uint64_t>(v), 8); }
+  void i32(std::int32_t v) { little(static_cast<std::uint32_t>(v), 4); }
+  void f32(float v) {
+    std::uint32_t bits = 0;
+    std::memcpy(&bits, &v, sizeof bits);
+    little(bits, 4);
+  }
   void f64(double v) {
     std::uint64_t bits = 0;
     std::memcpy(&bits, &v, sizeof bits);
@@ -46,6 +53,13 @@ class ByteReader {
   std::uint32_t u32() { return static_cast<std::uint32_t>(little(4)); }
   std::uint64_t u64() { return little(8); }
   std::int64_t i64() { return static_cast<std::int64_t>(little(8)); }
+  std::int32_t i32() { return static_cast<std::int32_t>(static_cast<std::uint32_t>(little(4))); }
+  float f32() {
+    const auto bits = static_cast<std::uint32_t>(little(4));
+    float v = 0.0F;
+    std::memcpy(&v, &bits, sizeof v);
+    return v;
+  }
   double f64() {
     const std::uint64_t bits = little(8);
     double v = 0.0;
@@ -92,6 +106,24 @@ inline void encode_cycle(const control::JournalRecord& r, ByteWriter& out) {
     out.f64(v);
   }
   out.u8(static_cast<std::uint8_t>(r.safe_reason));
+  out.u32(r.touched_triangles);
+  for (const float v : r.force_n) {
+    out.f32(v);
+  }
+}
+
+inline void encode_machine_command(const control::MachineCommandRecord& r, ByteWriter& out) {
+  out.u64(r.update);
+  out.i64(r.time_ns);
+  for (const std::int32_t v : r.motor_target) {
+    out.i32(v);
+  }
+  for (const std::uint8_t v : r.order) {
+    out.u8(v);
+  }
+  for (const double v : r.target_tip_mm) {
+    out.f64(v);
+  }
 }
 
 }  // namespace stencil::journal

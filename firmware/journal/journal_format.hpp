@@ -1,7 +1,7 @@
 // The journal's bytes: what a job recorded, append-only, so that a crash loses at most the records
 // not yet synced and never misreads a torn one.
 //
-// File: the magic "STENCILJ", a u32 version (1), then records. All numbers little-endian.
+// File: the magic "STENCILJ", a u32 version (2), then records. All numbers little-endian.
 // Record: u32 payload length, u8 type, the payload, u32 CRC-32 (zlib's) of the length, type and
 // payload bytes. A reader stops at the first record that is incomplete or fails its CRC: that and
 // everything after it is the torn tail of a crash, reported and ignored.
@@ -13,7 +13,7 @@
 namespace stencil::journal {
 
 inline constexpr char kMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L', 'J'};
-inline constexpr std::uint32_t kVersion = 1;
+inline constexpr std::uint32_t kVersion = 2;
 inline constexpr std::size_t kFileHeaderBytes = 12;
 inline constexpr std::size_t kRecordOverheadBytes = 9;  // length, type, CRC
 // No record is longer; a length over this is a torn or damaged record, not a reason to allocate.
@@ -23,14 +23,27 @@ enum class RecordType : std::uint8_t {
   Start = 1,      // the job: which tables, when, which program
   Cycle = 2,      // one cycle: the device sample it read and the virtual tool it left
   SafeState = 3,  // the cycle entered its safe state (synced at once)
+  Homed = 4,      // the machine homed: its tool is at home from here (written through at once)
+  MachineCommand = 5,  // a target, recorded by the machine thread before it is sent (written through)
+  Resume = 6,     // a resumed job's next segment starts here (its cycles count from 0 again)
 };
 
 // Payload of Start: u32 tables' CRC-32, u32 triangle count, i64 start (ns since the Unix epoch),
-// u16 program name length and its bytes.
+// u16 program name length and its bytes, u16 job length and its bytes (what the program needs to
+// carry the same job on: a simulation's pattern and stock, for instance).
 // Payload of Cycle (86 bytes): u64 cycle, i64 time_ns, f64 device_mm[3], f64 angles_rad[2],
-// u32 sample_counter, u8 fresh, f64 virtual_tip_mm[3], u8 safe_reason.
-inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1;
+// u32 sample_counter, u8 fresh, f64 virtual_tip_mm[3], u8 safe_reason, u32 touched_triangles,
+// f32 force_n[3].
+inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1 + 4 + 12;
 // Payload of SafeState: u64 cycle, u8 reason (control::SafeReason).
 inline constexpr std::uint32_t kSafeStatePayloadBytes = 9;
+// Payload of Homed: i64 time_ns (the machine's clock).
+inline constexpr std::uint32_t kHomedPayloadBytes = 8;
+// Payload of MachineCommand (55 bytes): u64 update, i64 time_ns, i32 motor_target[3], u8 order[3]
+// (each 0-2, or 3 for no leg), f64 target_tip_mm[3].
+inline constexpr std::uint32_t kMachineCommandPayloadBytes = 8 + 8 + 12 + 3 + 24;
+// Payload of Resume: u32 segment (1 for the first resume), i64 start (ns since the Unix epoch),
+// f64 script_s and f64 approach_s (a simulated operator's: where its script carries on and how long
+// the way back to the cut takes first; 0 for a person), u16 program name length and its bytes.
 
 }  // namespace stencil::journal

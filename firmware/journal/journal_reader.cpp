@@ -1,6 +1,7 @@
 // The journal reader: the header, then record by record until the bytes or the whole records end.
 #include "firmware/journal/journal_reader.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -72,11 +73,18 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         start.triangle_count = body.u32();
         start.unix_time_ns = body.i64();
         const std::uint16_t name = body.u16();
-        if (body.overrun() || body.left() != name) {
+        if (body.overrun() || body.left() < name + 2U || name > 256) {
           result.error = at(offset) + "a start record of " + std::to_string(length) + " bytes that does not hold its program name";
           return result;
         }
         start.program.assign(reinterpret_cast<const char*>(body.here()), name);
+        body.skip(name);
+        const std::uint16_t job = body.u16();
+        if (body.overrun() || body.left() != job || job > 1024) {
+          result.error = at(offset) + "a start record of " + std::to_string(length) + " bytes that does not hold its job";
+          return result;
+        }
+        start.job.assign(reinterpret_cast<const char*>(body.here()), job);
         if (visit.start) {
           visit.start(start);
         }
@@ -110,6 +118,10 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         r.fresh = fresh == 1;
         r.safe_reason = static_cast<control::SafeReason>(reason);
+        r.touched_triangles = body.u32();
+        for (float& v : r.force_n) {
+          v = body.f32();
+        }
         if (visit.cycle) {
           visit.cycle(r);
         }
@@ -132,9 +144,70 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         break;
       }
+      case RecordType::Homed: {
+        if (length != kHomedPayloadBytes) {
+          result.error = at(offset) + "a homed record of " + std::to_string(length) + " bytes (expected " +
+                         std::to_string(kHomedPayloadBytes) + ")";
+          return result;
+        }
+        const std::int64_t time_ns = body.i64();
+        if (visit.homed) {
+          visit.homed(time_ns);
+        }
+        break;
+      }
+      case RecordType::MachineCommand: {
+        if (length != kMachineCommandPayloadBytes) {
+          result.error = at(offset) + "a machine command record of " + std::to_string(length) + " bytes (expected " +
+                         std::to_string(kMachineCommandPayloadBytes) + ")";
+          return result;
+        }
+        control::MachineCommandRecord r{};
+        r.update = body.u64();
+        r.time_ns = body.i64();
+        for (std::int32_t& v : r.motor_target) {
+          v = body.i32();
+        }
+        for (std::uint8_t& v : r.order) {
+          v = body.u8();
+        }
+        bool finite = true;
+        for (double& v : r.target_tip_mm) {
+          v = body.f64();
+          finite = finite && std::isfinite(v);
+        }
+        if (r.order[0] > 3 || r.order[1] > 3 || r.order[2] > 3 || !finite) {
+          result.error = at(offset) + (finite ? "a machine command's leg order names an axis over 3"
+                                              : "a machine command's target is not a finite number");
+          return result;
+        }
+        if (visit.machine_command) {
+          visit.machine_command(r);
+        }
+        break;
+      }
+      case RecordType::Resume: {
+        JournalResume resume;
+        resume.segment = body.u32();
+        resume.unix_time_ns = body.i64();
+        resume.script_s = body.f64();
+        resume.approach_s = body.f64();
+        const std::uint16_t name = body.u16();
+        if (body.overrun() || body.left() != name || name > 256 || !std::isfinite(resume.script_s) ||
+            !std::isfinite(resume.approach_s) || resume.script_s < 0.0 || resume.approach_s < 0.0) {
+          result.error = at(offset) + "a resume record of " + std::to_string(length) +
+                         " bytes that does not hold its program name, or whose script times are not finite and >= 0";
+          return result;
+        }
+        resume.program.assign(reinterpret_cast<const char*>(body.here()), name);
+        if (visit.resume) {
+          visit.resume(resume);
+        }
+        break;
+      }
       default:
         result.error = at(offset) + "a record of type " + std::to_string(static_cast<int>(type)) +
-                       " (expected 1 start, 2 cycle or 3 safe state)";
+                       " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command or 6 resume)";
         return result;
     }
     ++result.records;
@@ -146,7 +219,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
   return result;
 }
 
-JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit) {
+JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit, std::size_t limit_bytes) {
   struct stat info {};
   if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) {
     JournalReadResult result;
@@ -159,7 +232,10 @@ JournalReadResult read_journal_file(const std::string& path, const JournalVisito
     result.error = path + ": cannot be read";
     return result;
   }
-  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (bytes.size() > limit_bytes) {
+    bytes.resize(limit_bytes);
+  }
   JournalReadResult result = read_journal(bytes.data(), bytes.size(), visit);
   if (!result.error.empty()) {
     result.error = path + ": " + result.error;

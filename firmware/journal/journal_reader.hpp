@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <functional>
 #include <string>
 
@@ -16,6 +17,9 @@ struct JournalVisitor {
   std::function<void(const JournalStart&)> start;
   std::function<void(const control::JournalRecord&)> cycle;
   std::function<void(std::uint64_t cycle, control::SafeReason)> safe_state;
+  std::function<void(std::int64_t time_ns)> homed;
+  std::function<void(const control::MachineCommandRecord&)> machine_command;
+  std::function<void(const JournalResume&)> resume;
 };
 
 struct JournalReadResult {
@@ -31,7 +35,8 @@ struct JournalReadResult {
 // wrong length for its type, a safe reason out of range) is an error: that is not a crash's doing.
 [[nodiscard]] JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const JournalVisitor& visit);
 
-// The same from a file; an unreadable file is an error naming it.
-[[nodiscard]] JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit);
+// The same from a file, its first `limit_bytes` at most; an unreadable file is an error naming it.
+[[nodiscard]] JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit,
+                                                  std::size_t limit_bytes = std::numeric_limits<std::size_t>::max());
 
 }  // namespace stencil::journal

@@ -27,6 +27,7 @@ bool JournalWriter::fail(const std::string& what, int error_number) {
 }
 
 bool JournalWriter::open(const std::string& path, const JournalStart& start) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   path_ = path;
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
@@ -43,8 +44,59 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
   const std::size_t name_length = std::min<std::size_t>(start.program.size(), 256);
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(start.program.data()), name_length);
+  const std::size_t job_length = std::min<std::size_t>(start.job.size(), 1024);
+  payload.u16(static_cast<std::uint16_t>(job_length));
+  payload.bytes(reinterpret_cast<const std::uint8_t*>(start.job.data()), job_length);
   add_record(RecordType::Start, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync();
+  return sync_locked();
+}
+
+bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_bytes, const JournalResume& resume) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  path_ = path;
+  fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  if (fd_ < 0) {
+    return fail("cannot be opened to carry on with it", errno);
+  }
+  if (::ftruncate(fd_, static_cast<off_t>(good_bytes)) != 0) {
+    return fail("cannot be cut to its " + std::to_string(good_bytes) + " whole bytes", errno);
+  }
+  if (::lseek(fd_, 0, SEEK_END) < 0) {
+    return fail("seek to its end failed", errno);
+  }
+  ByteWriter payload;
+  payload.u32(resume.segment);
+  payload.i64(resume.unix_time_ns);
+  payload.f64(resume.script_s);
+  payload.f64(resume.approach_s);
+  const std::size_t name_length = std::min<std::size_t>(resume.program.size(), 256);
+  payload.u16(static_cast<std::uint16_t>(name_length));
+  payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
+  add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  return sync_locked();
+}
+
+bool JournalWriter::append_homed(std::int64_t time_ns) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ < 0 || failed_) {
+    return false;
+  }
+  ByteWriter payload;
+  payload.i64(time_ns);
+  add_record(RecordType::Homed, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  return write_out();
+}
+
+bool JournalWriter::append_machine_command(const control::MachineCommandRecord& record) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ < 0 || failed_) {
+    return false;
+  }
+  ByteWriter payload;
+  encode_machine_command(record, payload);
+  add_record(RecordType::MachineCommand, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  ++machine_records_;
+  return write_out();  // in the file before the mill is sent it: a crash of this program cannot lose it
 }
 
 void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length) {
@@ -62,6 +114,7 @@ void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std
 }
 
 bool JournalWriter::append(const control::JournalRecord& r) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -75,7 +128,7 @@ bool JournalWriter::append(const control::JournalRecord& r) {
     event.u64(r.cycle);
     event.u8(static_cast<std::uint8_t>(r.safe_reason));
     add_record(RecordType::SafeState, event.data(), static_cast<std::uint32_t>(event.size()));
-    return sync();  // the event and everything before it are on the disk before anything else
+    return sync_locked();  // the event and everything before it are on the disk before anything else
   }
   if (r.safe_reason == control::SafeReason::None) {
     in_safe_state_ = false;  // reset: the next safe state is a new event
@@ -101,6 +154,11 @@ bool JournalWriter::write_out() {
 }
 
 bool JournalWriter::sync() {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  return sync_locked();
+}
+
+bool JournalWriter::sync_locked() {
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -115,6 +173,7 @@ bool JournalWriter::sync() {
 }
 
 bool JournalWriter::sync_if_due(std::int64_t now_ns) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -123,14 +182,15 @@ bool JournalWriter::sync_if_due(std::int64_t now_ns) {
   }
   synced_once_ = true;
   last_sync_ns_ = now_ns;
-  return sync();
+  return sync_locked();
 }
 
 bool JournalWriter::close() {
+  const std::lock_guard<std::mutex> lock(mutex_);
   if (fd_ < 0) {
     return !failed_;
   }
-  const bool synced = failed_ ? false : sync();
+  const bool synced = failed_ ? false : sync_locked();
   const bool closed = ::close(fd_) == 0;
   fd_ = -1;
   if (!closed && synced) {

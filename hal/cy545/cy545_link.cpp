@@ -273,7 +273,9 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
   if (!number_command('F', config_.homing_rate, 27000, command) || !send(command, deadline_ns)) {
     return {false, MachineRefusal::None, fault_};
   }
-  for (std::size_t axis = 0; axis < 3; ++axis) {
+  // Z first: after a crash or a stop mid-cut the tool may stand in the stock, and only raising it
+  // first takes it out without ploughing sideways through the work.
+  for (const std::size_t axis : {std::size_t{2}, std::size_t{0}, std::size_t{1}}) {
     // The axis's channel, its switch on the input line, then the seek (busy for an unknown time up
     // to the longest travel: nothing is sent until that has passed).
     if (!select_channel(config_.motor_channel[axis], deadline_ns) ||

@@ -123,6 +123,14 @@ void MachinedPart::flush() {
   }
 }
 
+void MachinedPart::cut_recorded_leg(const Eigen::Vector3d& from_mm, const Eigen::Vector3d& to_mm) {
+  stock_.cut(from_mm, to_mm, tool_);
+  if (gouge_measured_) {
+    max_gouge_mm_ = std::max(max_gouge_mm_, leg_gouge(from_mm, to_mm));
+  }
+  ++legs_;
+}
+
 void MachinedPart::finish_leg() {
   stock_.cut(leg_start_, leg_end_, tool_);
   if (gouge_measured_) {

@@ -48,6 +48,9 @@ class MachinedPart final : public MillMotionObserver {
   void axis_moved(Axis axis, const std::array<std::int64_t, kMillAxisCount>& axis_steps) override;
   // Motion stopped: the current leg ends here.
   void flush();
+  // A leg the mill made before this run (a resumed job's journal), world mm: cut and measured as one
+  // it follows would be. Before arm().
+  void cut_recorded_leg(const Eigen::Vector3d& from_mm, const Eigen::Vector3d& to_mm);
 
   // Every corner is also written to `trace` as t_s,x_mm,y_mm,z_mm (null: none).
   void set_trace(std::FILE* trace) { trace_ = trace; }

@@ -157,6 +157,32 @@ void walk_to(OperatorScript& script, const Eigen::Vector3d& to_world_mm, double 
   script.angles_rad.push_back(Eigen::Vector2d::Zero());
 }
 
+OperatorScript carry_on(const OperatorScript& script, double from_s, const Eigen::Vector3d& home_world_mm,
+                        const Eigen::Vector3d& rejoin_world_mm, double speed_mm_per_s, double scale, double& approach_s) {
+  OperatorScript out;
+  const auto walk = [&](const Eigen::Vector3d& to_world) {
+    if (out.t_s.empty() || (scale * to_world - out.device_mm.back()).norm() > 1e-9) {
+      walk_to(out, to_world, speed_mm_per_s, scale);
+    }
+  };
+  // One axis at a time, as the virtual tool's speed limit counts |dx| + |dy| + |dz|: a diagonal at the
+  // hand's speed would leave the tool behind, pulling on the hand.
+  walk(home_world_mm);
+  walk({rejoin_world_mm.x(), home_world_mm.y(), home_world_mm.z()});
+  walk({rejoin_world_mm.x(), rejoin_world_mm.y(), home_world_mm.z()});
+  walk(rejoin_world_mm);
+  walk(script.position_at(from_s) / scale);
+  approach_s = out.duration_s();
+  for (std::size_t i = 0; i < script.t_s.size(); ++i) {
+    if (script.t_s[i] > from_s) {
+      out.t_s.push_back(approach_s + script.t_s[i] - from_s);
+      out.device_mm.push_back(script.device_mm[i]);
+      out.angles_rad.push_back(script.angles_rad[i]);
+    }
+  }
+  return out;
+}
+
 OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
                             double speed_mm_per_s, double scale, std::uint64_t seed,
                             const std::function<double(double, double)>& touch_tip) {

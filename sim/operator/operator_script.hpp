@@ -49,6 +49,13 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
                                           double speed_mm_per_s, double device_mm_per_world_mm, std::uint64_t seed,
                                           const std::function<double(double, double)>& touch_tip);
 
+// The way back into a job that stopped (a resume): from `home` across at home's height to above
+// `rejoin` (world; along x, then y), straight down to it, then to where `script` was at `from_s`, and on with the rest
+// of `script` from there. `approach_s` is how long the way back takes.
+[[nodiscard]] OperatorScript carry_on(const OperatorScript& script, double from_s, const Eigen::Vector3d& home_world_mm,
+                                      const Eigen::Vector3d& rejoin_world_mm, double speed_mm_per_s,
+                                      double device_mm_per_world_mm, double& approach_s);
+
 // One comma-separated field as a finite number: all of it (trailing blanks and a carriage return
 // aside), or false. For the CSV reader and the programs' number lists alike.
 [[nodiscard]] bool parse_finite_field(const std::string& field, double& value);

@@ -53,6 +53,33 @@ at_most() {
   awk -v v="$1" -v l="$2" 'BEGIN { exit !(v != "null" && v + 0 <= l + 0) }' || fail "$3 is $1; expected at most $2"
 }
 
+# journal_size_ok JOURNAL REPORT EVENTS WHAT: the journal is exactly the file header, its start
+# record, a 111-byte record per cycle, the 17-byte homing, a 64-byte record per machine command and
+# an 18-byte record per safe-state event (EVENTS), as the report counts them.
+journal_size_ok() {
+  local journal=$1 report=$2 events=$3 what=$4 start cycles commands size expected
+  start=$(od -An -tu4 -j12 -N4 "$journal" | tr -d ' ')
+  cycles=$(json_number "$report" cycles)
+  commands=$(json_number "$report" machine_records)
+  size=$(stat -c %s "$journal")
+  expected=$((12 + 9 + start + 111 * cycles + 17 + 64 * commands + 18 * events))
+  [ "$size" -eq "$expected" ] ||
+    fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $events safe-state events)"
+  # Every target sent is in the journal (recorded before it is sent).
+  awk -v c="$commands" -v u="$(json_number "$report" updates)" 'BEGIN { exit !(c >= u) }' ||
+    fail "$what: $commands machine commands journalled, $(json_number "$report" updates) sent"
+}
+
+# stock_within CSV REFERENCE LIMIT WHAT: every cell of the two stocks within LIMIT mm.
+stock_within() {
+  local worst
+  worst=$(awk -F, 'NR == FNR { for (i = 1; i <= NF; i++) a[FNR "," i] = $i; rows = FNR; next }
+    { for (i = 1; i <= NF; i++) { d = $i - a[FNR "," i]; if (d < 0) d = -d; if (d > m) m = d } n = FNR }
+    END { if (n != rows) print "rows"; else printf "%.6f", m + 0 }' "$2" "$1")
+  [ "$worst" != "rows" ] || fail "$4: $1 and $2 have different sizes"
+  at_most "$worst" "$3" "$4: the largest difference of any stock cell from the uninterrupted run's (mm)"
+}
+
 no_gouge() {
   at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
   grep -q '"safe_state": null' report.json || fail "the run ended in a safe state: $(grep safe_state report.json)"
@@ -107,9 +134,9 @@ case_same_report_twice() {
   strip_wall_clock() {
     awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
-  run_sim --fast --pattern random --seed 3 --duration 60 --report first.json
+  run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report first.json
   expect_status 0
-  run_sim --fast --pattern random --seed 3 --duration 60 --report second.json
+  run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report second.json
   expect_status 0
   if ! diff <(strip_wall_clock first.json) <(strip_wall_clock second.json); then
     fail "two runs of the same job gave different reports"
@@ -122,10 +149,10 @@ case_pio_and_can_give_the_same_result() {
   strip_wall_clock() {
     awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
-  run_sim --fast --pattern plunge --duration 90 --haptic-transport pio --report pio.json
+  run_sim --fast --pattern plunge --duration 90 --haptic-transport pio --no-journal --report pio.json
   expect_status 0
   cp pio.json report.json && no_gouge
-  run_sim --fast --pattern plunge --duration 90 --haptic-transport can --report can.json
+  run_sim --fast --pattern plunge --duration 90 --haptic-transport can --no-journal --report can.json
   expect_status 0
   cp can.json report.json && no_gouge
   if ! diff <(strip_wall_clock pio.json) <(strip_wall_clock can.json); then
@@ -162,9 +189,9 @@ case_speed_n_is_fast_mode_paced() {
   strip_wall_clock() {
     awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
-  run_sim --fast --pattern plunge --duration 12 --report fast.json
+  run_sim --fast --pattern plunge --duration 12 --no-journal --report fast.json
   expect_status 0
-  run_sim --speed 20 --pattern plunge --duration 12 --report paced.json
+  run_sim --speed 20 --pattern plunge --duration 12 --no-journal --report paced.json
   expect_status 0
   if ! diff <(strip_wall_clock fast.json) <(strip_wall_clock paced.json); then
     fail "--speed 20 and --fast gave different reports"
@@ -175,33 +202,41 @@ case_speed_n_is_fast_mode_paced() {
   awk -v w="$wall" 'BEGIN { exit !(w + 0 >= 0.6) }' || fail "12 simulated s at --speed 20 took $wall s; expected at least 0.6 s"
 }
 
-# --journal: every cycle's record reaches the file (12 header bytes, the 38-byte start record naming
-# stencil-sim, 95 bytes a cycle); a journal that cannot be created is refused before the run.
+# --journal: every cycle's record and every machine command reach the file; a journal that cannot
+# be created is refused before the run. Without --journal the journal is named after the start time.
 case_journal_holds_every_cycle() {
   run_sim --fast --pattern plunge --duration 5 --journal job.journal --report report.json
   expect_status 0
   grep -q '"cycle_records"' report.json || fail "the report does not describe the journal"
-  local cycles records size
+  local cycles records
   cycles=$(json_number report.json cycles)
   records=$(json_number report.json cycle_records)
   [ "$records" = "$cycles" ] || fail "the journal holds $records cycle records; the run had $cycles cycles"
-  size=$(stat -c %s job.journal)
-  [ "$size" -eq $((12 + 38 + 95 * cycles)) ] || fail "job.journal is $size bytes; expected $((12 + 38 + 95 * cycles))"
+  journal_size_ok job.journal report.json 0 "plunge"
   head -c 8 job.journal | grep -q STENCILJ || fail "job.journal does not start with the magic STENCILJ"
   run_sim --fast --pattern plunge --duration 5 --journal /nonexistent/job.journal --report report2.json
   expect_status 2
   expect_stderr "/nonexistent/job.journal: cannot be created: No such file or directory" "which journal and why"
   [ ! -e report2.json ] || fail "a refused run left a report behind"
+  run_sim --fast --pattern plunge --duration 1 --report report3.json
+  expect_status 0
+  local named
+  named=$(sed -n 's/^journal: //p' stdout.txt)
+  echo "$named" | grep -Eq '^stencil-sim-[0-9]{8}-[0-9]{6}[.]journal$' || fail "the default journal is '$named'; expected stencil-sim-YYYYMMDD-HHMMSS.journal"
+  [ -s "$named" ] || fail "the default journal $named was not written"
+  run_sim --fast --pattern plunge --duration 1 --no-journal --report report4.json
+  expect_status 0
+  grep -q '"journal": null' report4.json || fail "--no-journal still wrote a journal"
 }
 
 # SIGTERM mid-cut: the run ends in the safe state "stopped" (exit 3) with its report and journal
-# written, the safe-state event in the journal (18 bytes after the cycles').
+# written, the safe-state event in the journal.
 case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
   echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIGTERM once cutting)"
   "$sim" --speed 10 --pattern raster --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
   local pid=$! waited=0
   # Mid-cut: once the journal holds about a simulated second of cycles (slow builds take a while).
-  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt 100000 ] && [ "$waited" -lt 600 ]; do
+  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt 120000 ] && [ "$waited" -lt 600 ]; do
     sleep 0.1
     waited=$((waited + 1))
   done
@@ -213,26 +248,62 @@ case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
   expect_status 3
   grep -q '"safe_state": "stopped"' report.json || fail "the report does not give the safe state stopped: $(grep safe_state report.json)"
   grep -q "safe state: stopped" stdout.txt || fail "the summary does not say the run was stopped"
-  local cycles size
-  cycles=$(json_number report.json cycles)
-  size=$(stat -c %s job.journal)
-  [ "$size" -eq $((12 + 38 + 95 * cycles + 18)) ] ||
-    fail "job.journal is $size bytes; expected $((12 + 38 + 95 * cycles + 18)) ($cycles cycles and the safe-state event)"
+  journal_size_ok job.journal report.json 1 "SIGTERM"
 }
 
-# The fault-injection cases: a raster job, one fault 30 simulated seconds in. Each must end in the
-# named safe state (exit 3), within DETECT seconds of the fault; the device must drive no force
-# within one period of the safe state, the mill be held and stopped by the machine update after the
-# one under way (two updates: 67 ms), the journal hold the event, and nothing be gouged.
+# The fault suite's job, shared by every case: a raster over a tall block beside home, so that the
+# cut is under way 25 s in; 60 simulated seconds. The uninterrupted run is the reference_job case,
+# which the fault cases need first (a ctest fixture); its stock is kept in the shared folder.
+fault_job=(--fast --pattern raster --stock 40,17,0,48,23,20 --duration 60)
+shared="$work_root/shared"
+
+case_reference_job() {
+  mkdir -p "$shared"
+  rm -f "$shared/reference.csv"
+  run_sim "${fault_job[@]}" --no-journal --report report.json --stock-csv reference.csv
+  expect_status 0
+  no_gouge
+  local removed
+  removed=$(grep -A1 '"removed"' report.json | json_number /dev/stdin volume_mm3)
+  awk -v r="$removed" 'BEGIN { exit !(r + 0 > 10) }' || fail "the reference job removed $removed mm3; expected a cut under way (over 10 mm3)"
+  [ "$failures" -eq 0 ] && cp reference.csv "$shared/reference.csv"
+}
+
+# resume_matches_reference REASON WHAT: carries the journal's job on to its end; it must end well,
+# cover both runs (the first ended in the safe state REASON; -: it has none, it was killed), rebuild the touched set the journal recorded, and leave every cell of the stock
+# within 0.01 mm of the uninterrupted run's.
+resume_matches_reference() {
+  local reason=$1 what=$2
+  [ -s "$shared/reference.csv" ] || { fail "$what: no reference stock (the reference_job case runs first)"; return; }
+  run_sim "${fault_job[@]}" --resume job.journal --report resumed.json --stock-csv resumed.csv
+  expect_status 0
+  grep -q "resume: job.journal: 1 run(s)" stdout.txt || fail "$what: the resume did not say what it found in the journal"
+  cp resumed.json report.json && no_gouge
+  [ "$(json_number resumed.json runs)" = 2 ] || fail "$what: the resumed report covers $(json_number resumed.json runs) runs; expected 2"
+  if [ "$reason" != - ]; then
+    grep -A4 '"safe_states"' resumed.json | grep -q "\"reason\": \"$reason\"" ||
+      fail "$what: the resumed report does not account for the first run's $reason"
+  else
+    grep -q '"safe_states": \[\]' resumed.json || fail "$what: the resumed report gives safe states nobody entered"
+  fi
+  [ "$(json_number resumed.json touched_recorded)" = "$(json_number resumed.json touched_rebuilt)" ] ||
+    fail "$what: the touched set rebuilt has $(json_number resumed.json touched_rebuilt) triangles; the journal recorded $(json_number resumed.json touched_recorded)"
+  stock_within resumed.csv "$shared/reference.csv" 0.01 "$what"
+}
+
+# The fault-injection cases: the shared job, one fault 40 simulated seconds in (mid-cut). Each must
+# end in the named safe state (exit 3), within DETECT seconds of the fault; the device must drive no
+# force within one period of the safe state, the mill be held and stopped by the machine update
+# after the one under way (two updates: 67 ms), the journal hold every cycle, command and the event,
+# and nothing be gouged. Then the job is resumed from its journal (resume_matches_reference).
 # expect_fault KIND REASON DETECT [TRANSPORT]
 expect_fault() {
   local kind=$1 reason=$2 detect=$3 transport=${4:-direct}
-  run_sim --fast --pattern raster --duration 60 --haptic-transport "$transport" --inject "$kind@30" --journal job.journal \
-    --report report.json
+  run_sim "${fault_job[@]}" --haptic-transport "$transport" --inject "$kind@40" --journal job.journal --report report.json
   expect_status 3
   grep -q "\"safe_state\": \"$reason\"" report.json || fail "$kind ended in $(grep '"safe_state"' report.json); expected $reason"
   at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
-  local injected safe force stopped cycles size
+  local injected safe force stopped
   injected=$(json_number report.json injected_s)
   safe=$(json_number report.json safe_state_s)
   force=$(json_number report.json force_zero_s)
@@ -243,10 +314,8 @@ expect_fault() {
     fail "$kind: no force at $force s, the safe state at $safe s; expected within one period"
   awk -v s="$safe" -v m="$stopped" 'BEGIN { exit !(m >= 0 && m - s <= 0.067) }' ||
     fail "$kind: the mill stopped at $stopped s, the safe state at $safe s; expected by the next machine update"
-  cycles=$(json_number report.json cycles)
-  size=$(stat -c %s job.journal)
-  [ "$size" -eq $((12 + 38 + 95 * cycles + 18)) ] ||
-    fail "$kind: job.journal is $size bytes; expected every cycle and the safe-state event ($((12 + 38 + 95 * cycles + 18)))"
+  journal_size_ok job.journal report.json 1 "$kind"
+  resume_matches_reference "$reason" "$kind"
 }
 
 case_fault_device_frozen() { expect_fault device-frozen device_stale 0.007; }
@@ -260,14 +329,41 @@ case_fault_cy545_silent() { expect_fault cy545-silent machine_fault 0.2; }
 case_fault_cy545_garbled() { expect_fault cy545-garbled machine_fault 0.2; }
 case_fault_serial_closed() { expect_fault serial-closed machine_fault 0.2; }
 case_fault_position_mismatch() { expect_fault position-mismatch machine_fault 0.2; }
+# 20 ms of bad CAN frames (a wrong DLC, pose halves whose counters disagree) and no good pose: refused
+# and counted, and after 5 periods without a fresh sample the cycle is in its safe state.
+case_fault_can_bad_frames() { expect_fault can-bad-frames device_stale 0.007 can; }
+# Every cycle 1.5 periods late from the fault on: the fourth overrun in a row is the safe state.
+case_fault_overrun_storm() { expect_fault overrun-storm overrun_storm 0.004; }
+
+# SIGKILL mid-cut (no handler runs, nothing is flushed on the way out), then --resume from the
+# journal: a torn tail, if the kill left one, is ignored, and the job carries on to the same stock as the uninterrupted run.
+case_kill_mid_cut_then_resume() {
+  local paced=(--speed 10 "${fault_job[@]:1}")
+  echo "\$ stencil-sim ${paced[*]} --journal job.journal --report report.json  (SIGKILL once cutting)"
+  "$sim" "${paced[@]}" --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
+  local pid=$! waited=0 size
+  # Mid-cut: 35 simulated seconds in (3.5 s at 10 x; the cut starts at about 25 s).
+  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt $((35000 * 111)) ] && [ "$waited" -lt 1200 ]; do
+    sleep 0.05
+    waited=$((waited + 1))
+  done
+  kill -KILL "$pid"
+  wait "$pid"
+  status=$?
+  echo "  exit status $status"
+  expect_status 137
+  [ ! -e report.json ] || fail "a killed run wrote a report"
+  resume_matches_reference - "SIGKILL"
+}
 
 # Garbage on the serial line between exchanges: the driver flushes its input before each query,
 # so the bytes are dropped and the job goes on, ungouged.
 case_fault_serial_garbage_is_flushed() {
-  run_sim --fast --pattern raster --duration 60 --inject serial-garbage@30 --report report.json
+  run_sim "${fault_job[@]}" --inject serial-garbage@40 --report report.json --stock-csv stock.csv
   expect_status 0
   no_gouge
   grep -q '"kind": "serial-garbage"' report.json || fail "the report does not name the injected fault"
+  [ -s "$shared/reference.csv" ] && stock_within stock.csv "$shared/reference.csv" 0.01 "serial-garbage"
 }
 
 # The journal's disk fills mid-cut (a 300 kB tmpfs: about three seconds of journal): the cut stops

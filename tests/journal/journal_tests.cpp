@@ -38,6 +38,10 @@ JournalRecord record_of(std::uint64_t cycle, SafeReason reason = SafeReason::Non
   r.virtual_tip_mm[1] = 12.5 + 1e-9 * static_cast<double>(cycle);
   r.virtual_tip_mm[2] = 7.25;
   r.safe_reason = reason;
+  r.touched_triangles = static_cast<std::uint32_t>(cycle / 7);
+  r.force_n[0] = 0.25F;
+  r.force_n[1] = -4.75F;
+  r.force_n[2] = static_cast<float>(cycle) * 1e-3F;
   return r;
 }
 
@@ -64,6 +68,7 @@ JournalStart start_of() {
   start.triangle_count = 92;
   start.unix_time_ns = 1'796'000'000'000'000'000;
   start.program = "journal_tests";
+  start.job = "pattern=raster seed=1";
   return start;
 }
 
@@ -82,6 +87,9 @@ struct Seen {
   int starts = 0;
   std::vector<JournalRecord> cycles;
   std::vector<std::pair<std::uint64_t, SafeReason>> events;
+  std::vector<std::int64_t> homings;
+  std::vector<stencil::control::MachineCommandRecord> commands;
+  std::vector<JournalResume> resumes;
   JournalStart start;
   JournalVisitor visitor() {
     return {[this](const JournalStart& s) {
@@ -89,7 +97,10 @@ struct Seen {
               start = s;
             },
             [this](const JournalRecord& r) { cycles.push_back(r); },
-            [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); }};
+            [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); },
+            [this](std::int64_t t) { homings.push_back(t); },
+            [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); },
+            [this](const JournalResume& r) { resumes.push_back(r); }};
   }
 };
 
@@ -104,6 +115,15 @@ void check_same(const JournalRecord& a, const JournalRecord& b) {
   LONGS_EQUAL(a.sample_counter, b.sample_counter);
   CHECK(a.fresh == b.fresh);
   CHECK(a.safe_reason == b.safe_reason);
+  LONGS_EQUAL(a.touched_triangles, b.touched_triangles);
+  for (int i = 0; i < 3; ++i) {
+    CHECK(a.force_n[i] == b.force_n[i]);
+  }
+}
+
+stencil::control::MachineCommandRecord command_of(std::uint64_t update) {
+  return {update, static_cast<std::int64_t>(update) * 33'333'333, {-1200, 35, static_cast<std::int32_t>(update)},
+          {2, 0, 3}, {25.125, 12.0 + 1e-7 * static_cast<double>(update), 3.0}};
 }
 
 }  // namespace
@@ -122,6 +142,7 @@ TEST(Journal, WhatIsWrittenReadsBackExactlyWithTheStartAndTheSafeStateEvent) {
   LONGS_EQUAL(92, seen.start.triangle_count);
   CHECK(seen.start.unix_time_ns == start_of().unix_time_ns);
   STRCMP_EQUAL("journal_tests", seen.start.program.c_str());
+  STRCMP_EQUAL("pattern=raster seed=1", seen.start.job.c_str());
   LONGS_EQUAL(300, seen.cycles.size());
   for (int i = 0; i < 300; ++i) {
     check_same(record_of(static_cast<std::uint64_t>(i), i >= 250 ? SafeReason::PoseJump : SafeReason::None),
@@ -190,7 +211,8 @@ TEST(Journal, AFlippedBitWithRecordsAfterItIsDamageThatSaysWhereAndInTheLastReco
   write_job(file.path, 5);
   const std::vector<std::uint8_t> whole = file.bytes();
   const std::size_t record = kRecordOverheadBytes + kCyclePayloadBytes;
-  const std::size_t start_record = kRecordOverheadBytes + 2 + 4 + 4 + 8 + std::string("journal_tests").size();
+  const std::size_t start_record = kRecordOverheadBytes + 4 + 4 + 8 + 2 + std::string("journal_tests").size() + 2 +
+                                   start_of().job.size();
   const std::size_t third = kFileHeaderBytes + start_record + 2 * record;
   std::vector<std::uint8_t> bytes = whole;
   bytes[third + 20] ^= 0x10;  // inside the third cycle record's payload
@@ -226,7 +248,7 @@ TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
   bytes[8] = 9;
   read = read_journal(bytes.data(), bytes.size(), seen.visitor());
   CHECK_FALSE(read.ok);
-  STRCMP_CONTAINS("journal offset 8: version 9; this program reads version 1", read.error.c_str());
+  STRCMP_CONTAINS("journal offset 8: version 9; this program reads version 2", read.error.c_str());
   read = read_journal_file("/nonexistent/journal", seen.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());
@@ -272,4 +294,91 @@ TEST(Journal, AWriteFailureReachesTheCycleEvenThroughAFullCommandRing) {
   CHECK(command.kind == stencil::control::CommandKind::JournalFailed);
   drain.drain(ring);
   CHECK_FALSE(commands.pop(command));  // once
+}
+
+// The machine thread's records are in the file the moment they are appended, with every cycle record
+// buffered before them: a crash of the program after a command was sent cannot lose it.
+TEST(Journal, AMachineCommandIsInTheFileAtOnceWithEverythingBeforeIt) {
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  for (int i = 0; i < 5; ++i) {
+    CHECK_TRUE(writer.append(record_of(static_cast<std::uint64_t>(i))));
+  }
+  CHECK_TRUE(writer.append_homed(123'456'789));
+  CHECK_TRUE(writer.append_machine_command(command_of(41)));
+  // Read while still open, as after a SIGKILL right here (no close, no sync).
+  Seen seen;
+  const std::vector<std::uint8_t> bytes = file.bytes();
+  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
+  CHECK_TRUE(read.ok);
+  LONGS_EQUAL(5, seen.cycles.size());
+  LONGS_EQUAL(1, seen.homings.size());
+  LONGS_EQUAL(123'456'789, seen.homings[0]);
+  LONGS_EQUAL(1, seen.commands.size());
+  const auto& c = seen.commands[0];
+  const auto want = command_of(41);
+  LONGS_EQUAL(41, c.update);
+  LONGS_EQUAL(want.time_ns, c.time_ns);
+  for (int i = 0; i < 3; ++i) {
+    LONGS_EQUAL(want.motor_target[i], c.motor_target[i]);
+    LONGS_EQUAL(want.order[i], c.order[i]);
+    CHECK(want.target_tip_mm[i] == c.target_tip_mm[i]);
+  }
+  LONGS_EQUAL(1, writer.machine_records());
+}
+
+// A resumed job carries on in the same file: the torn tail is cut off, the Resume record follows the
+// last whole record, and the records after it read on.
+TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
+  TempJournal file;
+  write_job(file.path, 20);
+  std::vector<std::uint8_t> whole = file.bytes();
+  {
+    std::ofstream cut(file.path, std::ios::binary | std::ios::trunc);
+    cut.write(reinterpret_cast<const char*>(whole.data()), static_cast<std::streamsize>(whole.size() - 30));
+  }
+  Seen before;
+  const JournalReadResult first = read_journal_file(file.path, before.visitor());
+  CHECK_TRUE(first.ok);
+  CHECK(first.tail_bytes > 0);
+  LONGS_EQUAL(19, before.cycles.size());
+  JournalWriter writer;
+  JournalResume resume;
+  resume.segment = 1;
+  resume.unix_time_ns = 77;
+  resume.script_s = 12.5;
+  resume.approach_s = 40.25;
+  resume.program = "stencil-sim";
+  CHECK_TRUE(writer.open_to_resume(file.path, first.good_bytes, resume));
+  CHECK_TRUE(writer.append(record_of(0)));
+  CHECK_TRUE(writer.close());
+  Seen after;
+  const JournalReadResult second = read_journal_file(file.path, after.visitor());
+  CHECK_TRUE(second.ok);
+  LONGS_EQUAL(0, second.tail_bytes);
+  LONGS_EQUAL(20, after.cycles.size());
+  LONGS_EQUAL(1, after.resumes.size());
+  LONGS_EQUAL(1, after.resumes[0].segment);
+  LONGS_EQUAL(77, after.resumes[0].unix_time_ns);
+  CHECK(after.resumes[0].script_s == 12.5 && after.resumes[0].approach_s == 40.25);
+  STRCMP_EQUAL("stencil-sim", after.resumes[0].program.c_str());
+  LONGS_EQUAL(0, after.cycles.back().cycle);
+}
+
+TEST(Journal, AMachineCommandThatNamesNoAxisOrAnInfiniteTargetIsAnErrorNamingTheOffset) {
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  auto bad = command_of(1);
+  bad.order[1] = 7;
+  CHECK_TRUE(writer.append_machine_command(bad));
+  CHECK_TRUE(writer.append_machine_command(command_of(2)));
+  CHECK_TRUE(writer.close());
+  Seen seen;
+  const JournalReadResult read = read_journal_file(file.path, seen.visitor());
+  CHECK_FALSE(read.ok);
+  CHECK(read.error.find("journal offset ") != std::string::npos);
+  CHECK(read.error.find("leg order") != std::string::npos);
+  LONGS_EQUAL(0, seen.commands.size());
 }
