@@ -7,6 +7,9 @@
 // cycles before its update, as on the rig, and nothing depends on the wall clock.
 #include "board/sim/sim_job.hpp"
 
+#include <cerrno>
+#include <cstring>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +19,7 @@
 
 #include <sys/socket.h>
 
+#include "board/sim/device_process.hpp"
 #include "firmware/control/controller.hpp"
 #include "firmware/control/loop_statistics.hpp"
 #include "firmware/control/machine_side.hpp"
@@ -99,6 +103,7 @@ class SimulatedDeviceWiring {
   }
 
   [[nodiscard]] bool ready() const { return transport_ == HapticTransport::Direct || simulated_ != nullptr; }
+  [[nodiscard]] stencil::sim::SimulatedHapticDevice* simulated() { return simulated_.get(); }
   [[nodiscard]] hal::HapticDevice& host() { return transport_ == HapticTransport::Direct ? direct_ : *host_; }
 
   // The device's millisecond: a new sample of the handle, the host's newest command taken.
@@ -372,6 +377,19 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     result.error = "the simulated device's link: " + wiring_error;
     return result;
   }
+  // The device in a process of its own: forked now, before any thread of this one starts.
+  const double job_duration_s = job.duration_s > 0.0 ? job.duration_s : job.script.duration_s();
+  DeviceProcess device_process;
+  if (job.device_process_log != nullptr) {
+    if (job.transport != HapticTransport::Pio || job.fault.kind != FaultKind::None) {
+      result.error = "the device runs in its own process only over the PIO window, and with no fault injected";
+      return result;
+    }
+    if (!device_process.start(*device.simulated(), hand, job.script, job_duration_s, !realtime, job.device_process_log)) {
+      result.error = std::string("the device's process could not be started: ") + std::strerror(errno);
+      return result;
+    }
+  }
 
   control::ControllerConfig config;
   config.frames = frames;
@@ -477,9 +495,11 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
           }
           const double t_s = static_cast<double>(now_ns - start_ns) / 1e9;
           // After the job's duration the hand holds still where the script had got to.
-          const double script_s = std::min(t_s, duration_s);
-          hand.step(job.script.position_at(script_s), device.rendered_force());
-          device.device_cycle(hand, job.script.angles_at(script_s), now_ns);
+          if (!device_process.running()) {
+            const double script_s = std::min(t_s, duration_s);
+            hand.step(job.script.position_at(script_s), device.rendered_force());
+            device.device_cycle(hand, job.script.angles_at(script_s), now_ns);
+          }
           const control::CycleStatus status = controller->step(now_ns, deadline_ns);
           controller->finish(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns(), deadline_ns + kPeriodNs);
           if (status == control::CycleStatus::SafeState) {
@@ -547,8 +567,12 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     // After the job's duration the hand holds still where the script had got to, while the mill
     // catches up: the same job always ends at the same place.
     const double script_s = std::min(t_s, duration_s);
-    hand.step(job.script.position_at(script_s), device.rendered_force());
-    device.device_cycle(hand, job.script.angles_at(script_s), cycle_ns);
+    if (device_process.running()) {
+      static_cast<void>(device_process.step(cycle_ns, script_s));  // no answer: no fresh sample, as from a hung device
+    } else {
+      hand.step(job.script.position_at(script_s), device.rendered_force());
+      device.device_cycle(hand, job.script.angles_at(script_s), cycle_ns);
+    }
     const auto wall_before = std::chrono::steady_clock::now();
     // An overrun storm: from the injection on, every cycle starts and ends 1.5 periods late, as on a
     // host that stalls the thread (lateness counts then, as on the wall clock).
@@ -561,7 +585,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     if (safe && result.safe_state_s < 0.0) {
       result.safe_state_s = t_s;
     }
-    if (result.safe_state_s >= 0.0 && result.force_zero_s < 0.0 && device.force_off()) {
+    if (result.safe_state_s >= 0.0 && result.force_zero_s < 0.0 &&
+        (device_process.running() ? device_process.force_off() : device.force_off())) {
       result.force_zero_s = t_s;  // what the device drives: the command it took this cycle
     }
     records.drain(rings->journal);

@@ -80,6 +80,9 @@ struct SimJob {
   std::string resume_from;
   std::size_t resume_bytes = 0;  // how much of it the job so far is (the file grows as this run carries on)
   FaultInjection fault;  // run_fast only
+  // run_realtime over Pio only: the simulated device and the hand run in a forked process of their
+  // own, which writes what its watchdog did when this process is gone to this file (null: in process).
+  std::FILE* device_process_log = nullptr;
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;

@@ -153,6 +153,12 @@ int main(int argc, char** argv) {
   app.add_option("--stock-csv", stock_csv_path,
                  "write the machined stock's heights here at the end: one row of the Z-map per line (y rising), "
                  "mm, cells of 0.05 mm from the stock's low corner");
+  std::string device_log_path;
+  app.add_option("--device-process", device_log_path,
+                 "LOG: with --haptic-transport pio only: the simulated device and the operator's hand run in a process of "
+                 "their own (on the virtual clock in lockstep with the cycle, so the job is the same job; in real time "
+                 "on the wall clock), so that if this one dies, even by SIGKILL, the device's own host watchdog zeroes "
+                 "the force; the device writes to LOG how long that took");
   app.add_option("--trace", trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
   app.add_option("--haptic-transport", transport,
                  "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
@@ -190,6 +196,9 @@ int main(int argc, char** argv) {
   }
   if (no_journal && !journal_path.empty()) {
     return bad_input("--journal and --no-journal: choose one");
+  }
+  if (!device_log_path.empty() && (transport != "pio" || !inject_text.empty())) {
+    return bad_input("--device-process: the device runs in its own process only with --haptic-transport pio and no --inject");
   }
   if (fast == (speed > 0.0)) {
     return bad_input(fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)");
@@ -357,6 +366,14 @@ int main(int argc, char** argv) {
     job.journal = &journal_writer;
     std::printf("journal: %s\n", journal_path.c_str());
   }
+  std::FILE* device_log = nullptr;
+  if (!device_log_path.empty()) {
+    device_log = std::fopen(device_log_path.c_str(), "w");
+    if (device_log == nullptr) {
+      return bad_input(device_log_path + ": cannot be written");
+    }
+    job.device_process_log = device_log;
+  }
   job.interrupted = &interrupted;
   board::sim::SimResult result;
   if (fast || speed != 1.0) {
@@ -387,6 +404,9 @@ int main(int argc, char** argv) {
   }
   if (trace != nullptr) {
     std::fclose(trace);
+  }
+  if (device_log != nullptr) {
+    std::fclose(device_log);
   }
   if (!result.started) {
     // Nothing was run: what this run created for its outputs goes too (a resumed journal stays).

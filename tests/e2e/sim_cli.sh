@@ -111,6 +111,26 @@ case_raster_corner() {
   grep -q '<svg' report.svg || fail "report.svg is not an SVG picture"
 }
 
+# The corner job stopped by a fault half-way (its tool in contact with the part by then), resumed
+# from the journal and carried on to completion: the touched set is rebuilt to what the journal
+# recorded, and the whole job meets the corner job's bars. (Cell by cell it is not the uninterrupted
+# run: after the way back the tool's contact with the walls differs by micrometres, and a Z-map
+# cell on a wall's edge can hold a sliver either way.)
+case_resume_after_a_fault_completes_the_corner_job() {
+  local corner=(--fast --pattern raster --until-complete --stock 15,3.6,0,25,12.5,7)
+  run_sim "${corner[@]}" --inject pose-jump@700 --journal job.journal --report first.json
+  expect_status 3
+  run_sim "${corner[@]}" --resume job.journal --report report.json
+  expect_status 0
+  no_gouge
+  at_most "$(json_number report.json fraction)" 0.01 "the unmachined fraction"
+  local recorded rebuilt
+  recorded=$(json_number report.json touched_recorded)
+  rebuilt=$(json_number report.json touched_rebuilt)
+  [ "$recorded" -gt 0 ] || fail "nothing was touched before the fault; the case does not test the rebuild"
+  [ "$recorded" = "$rebuilt" ] || fail "the touched set rebuilt has $rebuilt triangles; the journal recorded $recorded"
+}
+
 case_plunge() {
   run_sim --fast --pattern plunge --duration 150 --report report.json
   expect_status 0
@@ -335,13 +355,15 @@ case_fault_can_bad_frames() { expect_fault can-bad-frames device_stale 0.007 can
 # Every cycle 1.5 periods late from the fault on: the fourth overrun in a row is the safe state.
 case_fault_overrun_storm() { expect_fault overrun-storm overrun_storm 0.004; }
 
-# SIGKILL mid-cut (no handler runs, nothing is flushed on the way out), then --resume from the
-# journal: a torn tail, if the kill left one, is ignored, and the job carries on to the same stock as the uninterrupted run.
+# SIGKILL mid-cut (no handler runs, nothing is flushed on the way out), with the simulated device in
+# a process of its own over the PIO window: the device's own host watchdog zeroes the force (its
+# 20 ms, and a few on this host). Then --resume from the journal: a torn tail, if the kill left one,
+# is ignored, and the job carries on to the same stock as the uninterrupted run.
 case_kill_mid_cut_then_resume() {
-  local paced=(--speed 10 "${fault_job[@]:1}")
+  local paced=(--speed 10 "${fault_job[@]:1}" --haptic-transport pio --device-process device.log)
   echo "\$ stencil-sim ${paced[*]} --journal job.journal --report report.json  (SIGKILL once cutting)"
   "$sim" "${paced[@]}" --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
-  local pid=$! waited=0 size
+  local pid=$! waited=0 zero_ms
   # Mid-cut: 35 simulated seconds in (3.5 s at 10 x; the cut starts at about 25 s).
   while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt $((35000 * 111)) ] && [ "$waited" -lt 1200 ]; do
     sleep 0.05
@@ -353,6 +375,16 @@ case_kill_mid_cut_then_resume() {
   echo "  exit status $status"
   expect_status 137
   [ ! -e report.json ] || fail "a killed run wrote a report"
+  waited=0
+  while ! grep -q "^device: force zero\|a second after the controller" device.log 2>/dev/null && [ "$waited" -lt 100 ]; do
+    sleep 0.05
+    waited=$((waited + 1))
+  done
+  sed 's/^/  device.log: /' device.log
+  grep -q "the controller's process is gone" device.log || fail "the device did not notice its controller was gone"
+  zero_ms=$(sed -n 's/^device: force zero \([0-9.]*\) ms after.*/\1/p' device.log)
+  [ -n "$zero_ms" ] || fail "the device did not zero the force after the kill"
+  [ -n "$zero_ms" ] && at_most "$zero_ms" 40 "the time from the kill to zero force at the device (ms)"
   resume_matches_reference - "SIGKILL"
 }
 
