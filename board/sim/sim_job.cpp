@@ -38,6 +38,7 @@
 #include "sim/haptic_device/can_device_link.hpp"
 #include "sim/haptic_device/direct_haptic_device.hpp"
 #include "sim/haptic_device/pio_device_link.hpp"
+#include "sim/haptic_device/replay_haptic_device.hpp"
 #include "sim/haptic_device/simulated_haptic_device.hpp"
 #include "sim/mill/machined_part.hpp"
 #include "sim/mill/simulated_mill.hpp"
@@ -399,8 +400,10 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   config.count_overruns = realtime;  // on virtual time lateness means nothing
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
-  auto controller = std::make_unique<control::Controller>(
-      part, device.host(), rings->rings(), config);
+  // A replay's cycle reads the journal's device; any other's the simulated one.
+  stencil::sim::ReplayHapticDevice replay_device;
+  hal::HapticDevice& cycle_device = job.replay != nullptr ? static_cast<hal::HapticDevice&>(replay_device) : device.host();
+  auto controller = std::make_unique<control::Controller>(part, cycle_device, rings->rings(), config);
   if (!controller->ready()) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
@@ -455,7 +458,10 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     arm();
   }
 
-  const double duration_s = job.duration_s > 0.0 ? job.duration_s : job.script.duration_s();
+  // A replay ends with its records.
+  const double duration_s = job.replay != nullptr ? std::numeric_limits<double>::infinity()
+                            : job.duration_s > 0.0 ? job.duration_s
+                                                   : job.script.duration_s();
   // After the script, the mill is given up to this long to catch up with the virtual tool.
   constexpr double kCatchUpS = 30.0;
   if (realtime) {
@@ -567,7 +573,22 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     // After the job's duration the hand holds still where the script had got to, while the mill
     // catches up: the same job always ends at the same place.
     const double script_s = std::min(t_s, duration_s);
-    if (device_process.running()) {
+    const control::JournalRecord* recorded = nullptr;
+    if (job.replay != nullptr) {
+      if (result.replay_cycles == job.replay->size()) {
+        stop_after_update = true;  // the record ends here: one more machine update, then the end
+        next_update_ns = std::min(next_update_ns, cycle_ns);
+        continue;
+      }
+      recorded = &(*job.replay)[result.replay_cycles];
+      replay_device.set(*recorded);
+      // A safe state the device's read does not explain (the machine's fault, a stalled host, a
+      // stop): the record says it came, so it comes here too, at the same cycle.
+      if (recorded->safe_reason != control::SafeReason::None && controller->safe_reason() == control::SafeReason::None &&
+          !control::is_device_reason(recorded->safe_reason)) {
+        static_cast<void>(rings->commands.push({control::CommandKind::Stop}));
+      }
+    } else if (device_process.running()) {
       static_cast<void>(device_process.step(cycle_ns, script_s));  // no answer: no fresh sample, as from a hung device
     } else {
       hand.step(job.script.position_at(script_s), device.rendered_force());
@@ -580,6 +601,17 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const control::CycleStatus status = controller->step(cycle_ns + late_ns, cycle_ns);
     compute.add(std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - wall_before).count());
     controller->finish(cycle_ns + late_ns, cycle_ns + kPeriodNs);
+    if (recorded != nullptr) {
+      ++result.replay_cycles;
+      const Eigen::Vector3d tip = controller->virtual_tip_mm();
+      if (tip.x() != recorded->virtual_tip_mm[0] || tip.y() != recorded->virtual_tip_mm[1] ||
+          tip.z() != recorded->virtual_tip_mm[2]) {
+        if (result.replay_mismatches++ == 0) {
+          result.replay_first_mismatch = static_cast<std::int64_t>(recorded->cycle);
+        }
+      }
+      result.replay_recorded_reason = recorded->safe_reason;
+    }
     // The overrun watchdog may enter the safe state in finish(): it counts from this cycle.
     const bool safe = status == control::CycleStatus::SafeState || controller->safe_reason() != control::SafeReason::None;
     if (safe && result.safe_state_s < 0.0) {

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "firmware/control/cycle_messages.hpp"
 #include "firmware/control/safe_state.hpp"
 #include "firmware/journal/job_history.hpp"
 #include "firmware/motion/machine_frames.hpp"
@@ -83,6 +84,10 @@ struct SimJob {
   // run_realtime over Pio only: the simulated device and the hand run in a forked process of their
   // own, which writes what its watchdog did when this process is gone to this file (null: in process).
   std::FILE* device_process_log = nullptr;
+  // run_fast only: replay these recorded cycles (one run of a journal, in order) instead of the
+  // operator and the device; each cycle reads exactly what the recorded one read. With resume_from
+  // set to the runs before it, a resumed run is replayed from where it started.
+  const std::vector<control::JournalRecord>* replay = nullptr;
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;
@@ -138,6 +143,12 @@ struct SimResult {
   // The job before this run, from the journal it resumed (earlier.segments 0: a fresh job), and the
   // touched set's size the journal recorded against the one rebuilt from its virtual tool.
   journal::JobHistory earlier;
+  // A replay: cycles compared with the record, those whose virtual tool differs (bit for bit), the
+  // first of them (-1: none), and the safe state the record ended in.
+  std::uint64_t replay_cycles = 0;
+  std::uint64_t replay_mismatches = 0;
+  std::int64_t replay_first_mismatch = -1;
+  control::SafeReason replay_recorded_reason = control::SafeReason::None;
   std::uint32_t touched_rebuilt = 0;
   // The machined stock, the part's top and what is left to cut, for the picture: heights per cell, row-major.
   int columns = 0, rows = 0;

@@ -22,6 +22,7 @@
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
 #include "firmware/app/realtime_thread.hpp"
+#include "firmware/journal/journal_reader.hpp"
 #include "firmware/tables/table_loader.hpp"
 
 // The baked-in sample part (the hex prism), linked into its own read-only section.
@@ -73,6 +74,83 @@ bool parse_stock(const std::string& text, const tables::PartTables& part, sim::S
     }
   }
   return true;
+}
+
+// The picture goes beside the report, as .svg.
+std::string picture_path_of(const std::string& report_path) {
+  return (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
+              ? report_path.substr(0, report_path.size() - 5)
+              : report_path) +
+         ".svg";
+}
+
+// --replay: every run the journal holds, in turn, each from the state the runs before it left.
+int replay(const std::string& path, const tables::PartTables& part, board::sim::SimJob job, const std::string& report_path,
+           const std::string& stock_csv_path, double pace) {
+  journal::JobHistory history;
+  std::string error;
+  if (!journal::read_job_history(path, part.header.crc32, part.header.triangle_count, board::sim::frames(), {}, history,
+                                 error)) {
+    return bad_input("--replay: " + error);
+  }
+  // The stock the job was recorded on, from its start record.
+  const std::size_t at = history.start.job.find("stock=");
+  double box[6];
+  if (at == std::string::npos || std::sscanf(history.start.job.c_str() + at, "stock=%lf,%lf,%lf,%lf,%lf,%lf", &box[0], &box[1],
+                                             &box[2], &box[3], &box[4], &box[5]) != 6) {
+    return bad_input("--replay " + path + ": its start record names no stock (\"" + history.start.job + "\")");
+  }
+  job.stock = {{box[0], box[1], box[2]}, {box[3], box[4], box[5]}};
+  job.pace = pace;
+  job.until_complete = false;
+  std::printf("replay: %s: %u run(s), %llu cycles (%s)\n", path.c_str(), history.segments,
+              static_cast<unsigned long long>(history.cycles), history.start.job.c_str());
+  board::sim::SimResult result;
+  bool all_same = true;
+  const app::CpuLatencyHold latency_hold;
+  for (std::uint32_t run = 0; run < history.segments; ++run) {
+    std::vector<control::JournalRecord> records;
+    std::uint32_t in_run = 0;
+    journal::JournalVisitor keep;
+    keep.resume = [&](const journal::JournalResume&) { ++in_run; };
+    keep.cycle = [&](const control::JournalRecord& r) {
+      if (in_run == run) {
+        records.push_back(r);
+      }
+    };
+    const journal::JournalReadResult read = journal::read_journal_file(path, keep, history.good_bytes);
+    if (!read.ok) {
+      return bad_input("--replay: " + read.error);
+    }
+    job.replay = &records;
+    job.resume_from = run == 0 ? "" : path;
+    job.resume_bytes = run == 0 ? 0 : history.run_starts[run - 1];
+    result = board::sim::run_fast(job);
+    if (!result.started) {
+      std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
+      return kExitSafeState;
+    }
+    const bool reason_same = !control::is_device_reason(result.replay_recorded_reason) ||
+                             result.safe_state == result.replay_recorded_reason;
+    const bool same = result.replay_mismatches == 0 && result.replay_cycles == records.size() && reason_same;
+    all_same = all_same && same;
+    std::printf("replay run %u: %llu of %zu recorded cycles, %llu with a different virtual tool%s; recorded ending %s, "
+                "replayed %s: %s\n",
+                run, static_cast<unsigned long long>(result.replay_cycles), records.size(),
+                static_cast<unsigned long long>(result.replay_mismatches),
+                result.replay_first_mismatch >= 0 ? (" (the first at cycle " + std::to_string(result.replay_first_mismatch) + ")").c_str() : "",
+                control::safe_reason_name(result.replay_recorded_reason), control::safe_reason_name(result.safe_state),
+                same ? "the same" : "DIFFERENT");
+  }
+  std::printf("%s", board::sim::summary(result).c_str());
+  const std::string picture_path = picture_path_of(report_path);
+  if (!board::sim::write_report_json(report_path, result, error) || !board::sim::write_picture_svg(picture_path, result, error) ||
+      (!stock_csv_path.empty() && !board::sim::write_stock_csv(stock_csv_path, result, error))) {
+    return bad_input(error);
+  }
+  std::printf("report: %s\npicture: %s\n", report_path.c_str(), picture_path.c_str());
+  std::printf("replay: %s\n", all_same ? "every run replayed as recorded" : "the replay differs from the record");
+  return all_same ? kExitDone : kExitSafeState;
 }
 
 }  // namespace
@@ -150,6 +228,12 @@ int main(int argc, char** argv) {
                  "rebuilt from it, the machine homes again, the simulated operator goes back across at home's height "
                  "and down to where the cut stopped and carries on with its script; the journal carries on in the "
                  "same file and the report covers the whole job (--duration is then the whole job's)");
+  std::string replay_path;
+  app.add_option("--replay", replay_path,
+                 "re-run the job this journal recorded, deterministically, on the virtual clock: each cycle reads "
+                 "exactly what the recorded cycle read from the device (every run of a resumed job in turn, each "
+                 "from the state the runs before it left); says whether every cycle's virtual tool came out bit for "
+                 "bit as recorded (exit 0) or where it first differed (exit 3). Writes the report and no journal");
   app.add_option("--stock-csv", stock_csv_path,
                  "write the machined stock's heights here at the end: one row of the Z-map per line (y rising), "
                  "mm, cells of 0.05 mm from the stock's low corner");
@@ -190,6 +274,15 @@ int main(int argc, char** argv) {
     if (speed == 1.0) {
       return bad_input("--inject: faults are injected on the virtual clock (--fast or --speed N other than 1)");
     }
+  }
+  if (!replay_path.empty()) {
+    if (!resume_path.empty() || !journal_path.empty() || !inject_text.empty() || app.count("--device-process") > 0 ||
+        speed == 1.0) {
+      return bad_input("--replay runs the recorded job on the virtual clock by itself: no --resume, --journal, --inject, "
+                       "--device-process or --speed 1 with it");
+    }
+    fast = fast || speed == 0.0;
+    no_journal = true;
   }
   if (!resume_path.empty() && (!journal_path.empty() || no_journal)) {
     return bad_input("--resume carries on in the journal it resumes: no --journal or --no-journal with it");
@@ -253,6 +346,9 @@ int main(int argc, char** argv) {
                 operator_path.empty() ? "-" : operator_path.c_str(), operator_path.empty() ? pattern_name.c_str() : "-",
                 static_cast<unsigned long long>(seed), job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z(),
                 job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
+  if (!replay_path.empty()) {
+    return replay(replay_path, part, job, report_path, stock_csv_path, fast ? 0.0 : speed);
+  }
   journal::JobHistory history;
   journal::JournalResume resume;
   if (!resume_path.empty()) {
@@ -315,11 +411,7 @@ int main(int argc, char** argv) {
               job.stock.high_mm.z(), job.script.duration_s());
   std::fflush(stdout);
 
-  const std::string picture_path =
-      (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
-           ? report_path.substr(0, report_path.size() - 5)
-           : report_path) +
-      ".svg";
+  const std::string picture_path = picture_path_of(report_path);
   // The outputs can be written: found out now, not after the whole simulated job (every input has
   // been checked by now, so bad input leaves no report behind).
   for (const std::string& path : {report_path, picture_path}) {

@@ -110,6 +110,10 @@ void Controller::recall_touched(const Eigen::Vector3d& tip_mm) {
 bool Controller::read_device(hal::MonotonicNs now_ns) {
   hal::HapticSample sample{};
   const hal::ReadResult read = device_.read_sample(now_ns, sample);
+  read_ = read;
+  if (read.status == hal::ReadStatus::Fresh) {
+    read_sample_ = sample;  // the journal keeps what the device said, even if refused below
+  }
   fresh_ = false;
   switch (read.status) {
     case hal::ReadStatus::Fresh:
@@ -240,13 +244,18 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
   }
 
+  // The read as the device gave it (a replay feeds it back to the cycle), else the last sample used.
+  const hal::HapticSample& recorded = read_.status == hal::ReadStatus::Fresh ? read_sample_ : sample_;
   JournalRecord record{};
   record.cycle = cycle_;
   record.time_ns = now_ns;
-  copy3(device, record.device_mm);
-  record.angles_rad[0] = sample_.angles_rad[0];
-  record.angles_rad[1] = sample_.angles_rad[1];
-  record.sample_counter = sample_.sample_counter;
+  copy3(position_of(recorded), record.device_mm);
+  record.angles_rad[0] = recorded.angles_rad[0];
+  record.angles_rad[1] = recorded.angles_rad[1];
+  record.sample_counter = recorded.sample_counter;
+  record.status_bits = static_cast<std::uint16_t>(recorded.status_bits & 0xFFFFU);
+  record.read_status = read_.status;
+  record.read_reason = read_.reason;
   record.fresh = fresh_;
   copy3(tool_.tip_mm(), record.virtual_tip_mm);
   record.safe_reason = safe_reason_;  // as it stands before the machine handoff below

@@ -120,6 +120,8 @@ class Controller {
   SafeReason safe_reason_ = SafeReason::None;
   ResetOutcome last_reset_ = ResetOutcome::NotInSafeState;
   hal::HapticSample sample_{};             // the last accepted sample
+  hal::ReadResult read_{hal::ReadStatus::Stale, hal::HapticFault::None};  // this cycle's read, for the journal
+  hal::HapticSample read_sample_{};        // what it gave when Fresh, accepted here or not
   bool have_sample_ = false;
   bool fresh_ = false;                     // this cycle's read gave a new sample
   hal::MonotonicNs sample_time_ns_ = 0;    // when it was read

@@ -7,6 +7,7 @@
 #include "firmware/control/safe_state.hpp"
 #include "firmware/control/spsc_ring.hpp"
 #include "firmware/stencil/virtual_tool.hpp"
+#include "hal/haptic_device.hpp"
 
 namespace stencil::control {
 
@@ -89,11 +90,16 @@ struct JournalRecord {
   double device_mm[3];
   double angles_rad[2];
   std::uint32_t sample_counter;
-  bool fresh;                // a new sample this cycle
+  bool fresh;                // a new sample this cycle, accepted by the cycle
   double virtual_tip_mm[3];
   SafeReason safe_reason;    // as latched at the end of the cycle
   std::uint32_t touched_triangles;  // the touched set's size after the cycle: progress, and a check on a rebuild
   float force_n[3];          // as written to the device
+  // The cycle's read as the device gave it (device_mm, angles_rad, sample_counter and status_bits are
+  // its sample when read_status is Fresh, even if the cycle refused it; else the last sample used).
+  std::uint16_t status_bits;
+  hal::ReadStatus read_status;
+  hal::HapticFault read_reason;
 };
 
 // The rings around the cycle: capacities in the types. The machine side drains its ring at each

@@ -20,6 +20,13 @@ enum class SafeReason : std::uint8_t {
   Stopped,             // a stop command (SIGINT/SIGTERM, the terminal, the display)
 };
 
+// The reasons the device's own samples (or their absence) give: what a replay of the samples
+// reproduces by itself.
+[[nodiscard]] constexpr bool is_device_reason(SafeReason reason) {
+  return reason == SafeReason::DeviceStale || reason == SafeReason::DeviceFault || reason == SafeReason::PoseNotFinite ||
+         reason == SafeReason::PoseOutOfWorkspace || reason == SafeReason::PoseJump;
+}
+
 // A short fixed name, for reports and logs ("device_stale", ...).
 [[nodiscard]] const char* safe_reason_name(SafeReason reason);
 

@@ -30,6 +30,8 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
     segment_has_cycle = false;
   };
   JournalVisitor visit;
+  std::size_t record_offset = 0;
+  visit.offset = [&](std::size_t offset) { record_offset = offset; };
   visit.start = [&](const JournalStart& start) {
     misplaced = misplaced || started;
     started = true;
@@ -94,6 +96,7 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
   visit.resume = [&](const JournalResume& resume) {
     misplaced = misplaced || !started;
     close_segment();
+    history.run_starts.push_back(record_offset);
     ++history.segments;
     segment_script_s = resume.script_s;
     segment_approach_s = resume.approach_s;

@@ -39,6 +39,7 @@ struct JobHistory {
   Eigen::Vector3d last_virtual_tip_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_commanded_tip_mm = Eigen::Vector3d::Zero();  // home until the first target
   double script_s = 0.0;                // a simulated operator's script had got this far
+  std::vector<std::size_t> run_starts;  // where each run after the first starts (its Resume record)
   std::size_t good_bytes = 0;           // whole records end here: a resume cuts the file to this
   std::string tail;                     // what the torn tail was, when there was one
 };

@@ -110,6 +110,9 @@ inline void encode_cycle(const control::JournalRecord& r, ByteWriter& out) {
   for (const float v : r.force_n) {
     out.f32(v);
   }
+  out.u16(r.status_bits);
+  out.u8(static_cast<std::uint8_t>(r.read_status));
+  out.u8(static_cast<std::uint8_t>(r.read_reason));
 }
 
 inline void encode_machine_command(const control::MachineCommandRecord& r, ByteWriter& out) {

@@ -33,8 +33,8 @@ enum class RecordType : std::uint8_t {
 // carry the same job on: a simulation's pattern and stock, for instance).
 // Payload of Cycle (86 bytes): u64 cycle, i64 time_ns, f64 device_mm[3], f64 angles_rad[2],
 // u32 sample_counter, u8 fresh, f64 virtual_tip_mm[3], u8 safe_reason, u32 touched_triangles,
-// f32 force_n[3].
-inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1 + 4 + 12;
+// f32 force_n[3], u16 status_bits, u8 read_status (hal::ReadStatus), u8 read_reason (hal::HapticFault).
+inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1 + 4 + 12 + 2 + 1 + 1;
 // Payload of SafeState: u64 cycle, u8 reason (control::SafeReason).
 inline constexpr std::uint32_t kSafeStatePayloadBytes = 9;
 // Payload of Homed: i64 time_ns (the machine's clock).

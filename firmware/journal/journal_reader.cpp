@@ -3,11 +3,13 @@
 
 #include <cmath>
 #include <cstring>
-#include <fstream>
-#include <iterator>
+#include <algorithm>
 #include <vector>
 
+#include <fcntl.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <zlib.h>
 
 #include "firmware/control/safe_state.hpp"
@@ -66,6 +68,9 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
       break;
     }
     ByteReader body(payload, length);
+    if (visit.offset) {
+      visit.offset(offset);
+    }
     switch (type) {
       case RecordType::Start: {
         JournalStart start;
@@ -122,6 +127,17 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         for (float& v : r.force_n) {
           v = body.f32();
         }
+        r.status_bits = body.u16();
+        const std::uint8_t read_status = body.u8();
+        const std::uint8_t read_reason = body.u8();
+        if (read_status > static_cast<std::uint8_t>(hal::ReadStatus::Fault) ||
+            read_reason > static_cast<std::uint8_t>(hal::HapticFault::TransportFull)) {
+          result.error = at(offset) + "a cycle record's read status " + std::to_string(read_status) + " or reason " +
+                         std::to_string(read_reason) + " is out of range";
+          return result;
+        }
+        r.read_status = static_cast<hal::ReadStatus>(read_status);
+        r.read_reason = static_cast<hal::HapticFault>(read_reason);
         if (visit.cycle) {
           visit.cycle(r);
         }
@@ -220,23 +236,33 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
 }
 
 JournalReadResult read_journal_file(const std::string& path, const JournalVisitor& visit, std::size_t limit_bytes) {
+  JournalReadResult result;
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   struct stat info {};
-  if (::stat(path.c_str(), &info) == 0 && !S_ISREG(info.st_mode)) {
-    JournalReadResult result;
-    result.error = path + ": not a regular file (a journal is one)";
-    return result;
-  }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    JournalReadResult result;
+  if (fd < 0 || ::fstat(fd, &info) != 0) {
     result.error = path + ": cannot be read";
+  } else if (!S_ISREG(info.st_mode)) {
+    result.error = path + ": not a regular file (a journal is one)";
+  }
+  if (!result.error.empty()) {
+    if (fd >= 0) {
+      ::close(fd);
+    }
     return result;
   }
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (bytes.size() > limit_bytes) {
-    bytes.resize(limit_bytes);
+  // Mapped, not read in: an hours-long job's journal is gigabytes, and the page cache holds it.
+  const std::size_t size = std::min(static_cast<std::size_t>(info.st_size), limit_bytes);
+  void* mapped = size > 0 ? ::mmap(nullptr, size, PROT_READ, MAP_PRIVATE, fd, 0) : nullptr;
+  ::close(fd);
+  if (mapped == MAP_FAILED) {
+    result.error = path + ": cannot be mapped to be read";
+    return result;
   }
-  JournalReadResult result = read_journal(bytes.data(), bytes.size(), visit);
+  static const std::uint8_t kNothing = 0;
+  result = read_journal(mapped != nullptr ? static_cast<const std::uint8_t*>(mapped) : &kNothing, size, visit);
+  if (mapped != nullptr) {
+    ::munmap(mapped, size);
+  }
   if (!result.error.empty()) {
     result.error = path + ": " + result.error;
   }

@@ -54,7 +54,7 @@ at_most() {
 }
 
 # journal_size_ok JOURNAL REPORT EVENTS WHAT: the journal is exactly the file header, its start
-# record, a 111-byte record per cycle, the 17-byte homing, a 64-byte record per machine command and
+# record, a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command and
 # an 18-byte record per safe-state event (EVENTS), as the report counts them.
 journal_size_ok() {
   local journal=$1 report=$2 events=$3 what=$4 start cycles commands size expected
@@ -62,7 +62,7 @@ journal_size_ok() {
   cycles=$(json_number "$report" cycles)
   commands=$(json_number "$report" machine_records)
   size=$(stat -c %s "$journal")
-  expected=$((12 + 9 + start + 111 * cycles + 17 + 64 * commands + 18 * events))
+  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 18 * events))
   [ "$size" -eq "$expected" ] ||
     fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $events safe-state events)"
   # Every target sent is in the journal (recorded before it is sent).
@@ -129,6 +129,44 @@ case_resume_after_a_fault_completes_the_corner_job() {
   rebuilt=$(json_number report.json touched_rebuilt)
   [ "$recorded" -gt 0 ] || fail "nothing was touched before the fault; the case does not test the rebuild"
   [ "$recorded" = "$rebuilt" ] || fail "the touched set rebuilt has $rebuilt triangles; the journal recorded $recorded"
+}
+
+# --replay: the recorded job again on the virtual clock, every cycle reading what the recorded one
+# read: the faulted and resumed job (two runs, the second from the state the first left), and a
+# random walk into the part over CAN; every virtual tool bit for bit as recorded, the same stock.
+case_replay_gives_the_recorded_job_back() {
+  run_sim "${fault_job[@]}" --inject pose-jump@40 --journal job.journal --report first.json
+  expect_status 3
+  run_sim "${fault_job[@]}" --resume job.journal --report resumed.json --stock-csv resumed.csv
+  expect_status 0
+  run_sim --replay job.journal --report replay.json --stock-csv replayed.csv
+  expect_status 0
+  grep -q "replay run 0: 40021 of 40021 recorded cycles, 0 with a different virtual tool; recorded ending pose_jump, replayed pose_jump: the same" stdout.txt ||
+    fail "the faulted run did not replay as recorded"
+  grep -Eq "replay run 1: ([0-9]+) of \1 recorded cycles, 0 with a different virtual tool; recorded ending none, replayed none: the same" stdout.txt ||
+    fail "the resumed run did not replay as recorded"
+  cmp -s resumed.csv replayed.csv || fail "the replayed stock is not the recorded job's"
+  run_sim --fast --pattern random --seed 7 --duration 60 --haptic-transport can --journal walk.journal --report walk.json
+  expect_status 0
+  run_sim --replay walk.journal --report walk_replay.json
+  expect_status 0
+  grep -q "replay: every run replayed as recorded" stdout.txt || fail "the random walk over CAN did not replay as recorded"
+  [ "$(json_number walk.json max_force_n)" = "$(json_number walk_replay.json max_force_n)" ] ||
+    fail "the replay's largest force $(json_number walk_replay.json max_force_n) N is not the recorded $(json_number walk.json max_force_n) N"
+}
+
+# What --replay refuses: a journal that is not one, and options that have no place in a replay.
+case_replay_refuses_what_it_cannot_replay() {
+  printf 'not a journal' >junk.journal
+  run_sim --replay junk.journal
+  expect_status 2
+  expect_stderr "--replay: junk.journal: journal offset 0: not a journal" "the file and what is wrong with it"
+  run_sim --replay junk.journal --inject pose-nan@3
+  expect_status 2
+  expect_stderr "--replay runs the recorded job on the virtual clock by itself" "what cannot go with it"
+  run_sim --fast --resume junk.journal
+  expect_status 2
+  expect_stderr "--resume: junk.journal: journal offset 0: not a journal" "the file and what is wrong with it"
 }
 
 case_plunge() {
@@ -365,7 +403,7 @@ case_kill_mid_cut_then_resume() {
   "$sim" "${paced[@]}" --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
   local pid=$! waited=0 zero_ms
   # Mid-cut: 35 simulated seconds in (3.5 s at 10 x; the cut starts at about 25 s).
-  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt $((35000 * 111)) ] && [ "$waited" -lt 1200 ]; do
+  while [ "$(stat -c %s job.journal 2>/dev/null || echo 0)" -lt $((35000 * 115)) ] && [ "$waited" -lt 1200 ]; do
     sleep 0.05
     waited=$((waited + 1))
   done

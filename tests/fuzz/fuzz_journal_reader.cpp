@@ -74,7 +74,8 @@ int read_and_check(const std::uint8_t* data, std::size_t size) {
       [&](const stencil::journal::JournalResume& resume) {
         require(resume.program.size() <= 256);
         ++visits;
-      }};
+      },
+      [&](std::size_t offset) { require(offset >= stencil::journal::kFileHeaderBytes && offset < size); }};
   const stencil::journal::JournalReadResult read = stencil::journal::read_journal(data, size, visitor);
   require(read.ok == read.error.empty());
   require(visits == read.records);

@@ -42,6 +42,9 @@ JournalRecord record_of(std::uint64_t cycle, SafeReason reason = SafeReason::Non
   r.force_n[0] = 0.25F;
   r.force_n[1] = -4.75F;
   r.force_n[2] = static_cast<float>(cycle) * 1e-3F;
+  r.status_bits = 0x8001;
+  r.read_status = cycle % 3 == 0 ? stencil::hal::ReadStatus::Rejected : stencil::hal::ReadStatus::Fresh;
+  r.read_reason = cycle % 3 == 0 ? stencil::hal::HapticFault::SampleNotFinite : stencil::hal::HapticFault::None;
   return r;
 }
 
@@ -100,7 +103,8 @@ struct Seen {
             [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); },
             [this](std::int64_t t) { homings.push_back(t); },
             [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); },
-            [this](const JournalResume& r) { resumes.push_back(r); }};
+            [this](const JournalResume& r) { resumes.push_back(r); },
+            {}};
   }
 };
 
@@ -116,6 +120,8 @@ void check_same(const JournalRecord& a, const JournalRecord& b) {
   CHECK(a.fresh == b.fresh);
   CHECK(a.safe_reason == b.safe_reason);
   LONGS_EQUAL(a.touched_triangles, b.touched_triangles);
+  LONGS_EQUAL(a.status_bits, b.status_bits);
+  CHECK(a.read_status == b.read_status && a.read_reason == b.read_reason);
   for (int i = 0; i < 3; ++i) {
     CHECK(a.force_n[i] == b.force_n[i]);
   }
