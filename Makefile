@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt fuzz bench demo latency clean help
+.PHONY: all deps build test test-asan test-debug rt fuzz bench demo latency soak soak-asan clean help
 
 all: build
 
@@ -12,6 +12,8 @@ help:
 	@echo "make bench      time the engine (query, full cycle) beside brute force and FCL: build/bin/stencil-bench"
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
 	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
+	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
+	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
 
@@ -53,6 +55,18 @@ rt: deps
 latency: build
 	@bash toolchain/install-deps.sh --latency
 	bash toolchain/latency.sh
+
+# A measurement, not a test: one long job with random faults, resumed after each (toolchain/soak.sh).
+SOAK_HOURS ?= 8
+SOAK_FAULTS ?= 12
+SOAK_SEED ?= 1
+soak: build
+	bash toolchain/soak.sh build/bin/stencil-sim build/soak $(SOAK_HOURS) $(SOAK_FAULTS) $(SOAK_SEED)
+
+soak-asan: deps
+	cmake --preset asan
+	cmake --build --preset asan --target stencil-sim
+	bash toolchain/soak.sh build/asan/bin/stencil-sim build/soak-asan 0.5 4 $(SOAK_SEED)
 
 # Each fuzz target runs for FUZZ_SECONDS (two at once, one per core): `make fuzz FUZZ_SECONDS=600` for a long run.
 FUZZ_SECONDS ?= 60

@@ -17,7 +17,9 @@
 #include <memory>
 #include <thread>
 
+#include <sys/resource.h>
 #include <sys/socket.h>
+#include <unistd.h>
 
 #include "board/sim/device_process.hpp"
 #include "firmware/control/controller.hpp"
@@ -32,7 +34,6 @@
 #include "sim/cy545/fake_cy545_runner.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/shared_window_mapping.hpp"
-#include "hal/socketcan/can_codec.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
 #include "sim/haptic_device/can_device_link.hpp"
@@ -94,7 +95,9 @@ class SimulatedDeviceWiring {
       }
       host_channel_ = std::make_unique<hal::socketcan::FdCanChannel>(fds[0]);
       device_channel_ = std::make_unique<hal::socketcan::FdCanChannel>(fds[1]);
-      device_link_ = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
+      auto can_link = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
+      can_device_link_ = can_link.get();
+      device_link_ = std::move(can_link);
       can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), hal::kCornerOriginHapticRange);
       host_ = can_host_.get();
     }
@@ -117,9 +120,6 @@ class SimulatedDeviceWiring {
       const Eigen::Vector3d at = disturbed(hand.handle_mm);
       direct_.publish({{at.x(), at.y(), at.z()}, {angles.x(), angles.y()}, counter_,
                        hal::haptic_status::kForceApplied | (device_fault_ ? hal::haptic_status::kDeviceFault : 0U), counter_});
-    } else if (bad_frames_left_ > 0) {
-      send_bad_frames(hand);
-      --bad_frames_left_;
     } else {
       simulated_->step(now_ns);
     }
@@ -142,7 +142,9 @@ class SimulatedDeviceWiring {
         jump_ = true;
         break;
       case FaultKind::CanBadFrames:
-        bad_frames_left_ = 20;
+        if (can_device_link_ != nullptr) {
+          can_device_link_->babble(20);
+        }
         break;
       case FaultKind::DeviceFault:
         device_fault_ = true;
@@ -178,6 +180,7 @@ class SimulatedDeviceWiring {
   std::unique_ptr<hal::pio_shared_memory::SharedWindowMapping> window_;
   std::unique_ptr<hal::socketcan::FdCanChannel> host_channel_, device_channel_;
   std::unique_ptr<stencil::sim::DeviceSideLink> device_link_;
+  stencil::sim::CanDeviceLink* can_device_link_ = nullptr;  // device_link_, over CAN
   // The backends' destructors are theirs (HapticDevice's is protected): one owner each.
   std::unique_ptr<hal::pio_shared_memory::PioHapticDevice> pio_host_;
   std::unique_ptr<hal::socketcan::SocketCanHapticDevice> can_host_;
@@ -192,28 +195,6 @@ class SimulatedDeviceWiring {
   }
   std::unique_ptr<stencil::sim::SimulatedHapticDevice> simulated_;
   std::uint32_t counter_ = 0;
-  int bad_frames_left_ = 0;  // device milliseconds of bad frames still to send (CAN)
-  std::uint8_t bad_counter_ = 0;
-
-  // One millisecond of a babbling device: the pose with PoseA's DLC 5, then a PoseA and a PoseB
-  // whose counters disagree; no good pose gets through, and the status frame is not sent.
-  void send_bad_frames(const stencil::sim::OperatorHand& hand) {
-    hal::socketcan::PoseWire pose{};
-    pose.counter = ++bad_counter_;
-    for (int axis = 0; axis < 3; ++axis) {
-      pose.position_um[axis] = static_cast<std::int32_t>(std::lround(hand.handle_mm[axis] * 1e3));
-    }
-    can_frame a{}, b{};
-    if (!hal::socketcan::encode_pose(pose, a, b)) {
-      return;
-    }
-    can_frame short_a = a;
-    short_a.can_dlc = 5;
-    b.data[0] = static_cast<std::uint8_t>(b.data[0] + 1);
-    for (const can_frame& frame : {short_a, a, b}) {
-      static_cast<void>(device_channel_->send(frame));
-    }
-  }
 };
 
 }  // namespace
@@ -276,6 +257,25 @@ void inject(FaultKind kind, SimulatedDeviceWiring& device, stencil::sim::cy545::
   }
 }
 
+// This process's resident memory now, and the most it has been (getrusage), kB.
+std::int64_t resident_kb() {
+  long pages = 0, resident = 0;
+  std::FILE* statm = std::fopen("/proc/self/statm", "r");
+  if (statm != nullptr) {
+    if (std::fscanf(statm, "%ld %ld", &pages, &resident) != 2) {
+      resident = 0;
+    }
+    std::fclose(statm);
+  }
+  return static_cast<std::int64_t>(resident) * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+std::int64_t max_resident_kb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss;
+}
+
 // The result of a job from its parts, once they have stopped.
 SimResult finish_result(SimResult& result, const tables::PartTables& part, const control::Controller& controller,
                         const control::MachineSide& machine, const control::CommandedStock& model,
@@ -283,6 +283,8 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
                         const hal::cy545::Cy545Link& link, const control::MicrosecondHistogram& compute,
                         double simulated_s, std::chrono::steady_clock::time_point wall_start,
                         stencil::sim::SimulatedMill& mill, bool realtime) {
+  result.rss_at_end_kb = resident_kb();
+  result.max_rss_kb = max_resident_kb();
   stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
   result.cycles = controller.statistics().cycles;
   result.overruns = controller.statistics().overruns;
@@ -448,6 +450,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     return result;
   }
   result.started = true;
+  result.rss_after_setup_kb = resident_kb();
   const auto arm = [&] {
     machined.arm({mill.axis_position_steps(stencil::sim::Axis::x), mill.axis_position_steps(stencil::sim::Axis::y),
                   mill.axis_position_steps(stencil::sim::Axis::z)});

@@ -150,6 +150,11 @@ struct SimResult {
   std::int64_t replay_first_mismatch = -1;
   control::SafeReason replay_recorded_reason = control::SafeReason::None;
   std::uint32_t touched_rebuilt = 0;
+  // Memory: resident once the job was set up (the journal rebuilt, the machine homed), at its end,
+  // and the most it ever was (kB).
+  std::int64_t rss_after_setup_kb = 0;
+  std::int64_t rss_at_end_kb = 0;
+  std::int64_t max_rss_kb = 0;
   // The machined stock, the part's top and what is left to cut, for the picture: heights per cell, row-major.
   int columns = 0, rows = 0;
   double cell_mm = 0.0;

@@ -24,7 +24,18 @@ nlohmann::json job_json(const SimResult& r) {
   if (r.safe_state != control::SafeReason::None) {
     safe_states.push_back({{"run", r.earlier.segments}, {"cycle", r.cycles}, {"reason", control::safe_reason_name(r.safe_state)}});
   }
+  // How each run ended: the journal's End record, or none (killed, crashed); this run as it did.
+  nlohmann::json endings = nlohmann::json::array();
+  const auto ending_name = [](bool recorded, control::SafeReason reason) -> std::string {
+    return !recorded ? "unrecorded (killed or crashed)" : reason == control::SafeReason::None ? "finished" : control::safe_reason_name(reason);
+  };
+  for (std::size_t run = 0; run < r.earlier.endings.size(); ++run) {
+    const journal::RunEnding& e = r.earlier.endings[run];
+    endings.push_back({{"run", run}, {"ending", ending_name(e.recorded, e.reason)}, {"run_cycles", e.cycles}});
+  }
+  endings.push_back({{"run", r.earlier.segments}, {"ending", ending_name(true, r.safe_state)}, {"run_cycles", r.cycles}});
   return {{"runs", r.earlier.segments + 1},
+          {"run_endings", endings},
           {"total_cycles", r.earlier.cycles + r.cycles},
           {"total_simulated_s", r.earlier.recorded_s + r.simulated_s},
           {"earlier_machine_commands", r.earlier.machine_commands},
@@ -77,6 +88,7 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
                                                           {"machine_records", r.journal_machine_records},
                                                           {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
                                                                                             : nlohmann::json(r.journal_error)}}},
+      {"memory_kb", {{"after_setup", r.rss_after_setup_kb}, {"at_end", r.rss_at_end_kb}, {"most", r.max_rss_kb}}},
       {"simulated_s", r.simulated_s},
       {"wall_s", r.wall_s},
       {"wakeup_latency_us", quantiles_json(r.wakeup_latency_us)},

@@ -184,6 +184,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"raster", "plunge", "thinwall", "random"}))
       ->capture_default_str();
   app.add_option("--seed", seed, "the random pattern's seed")->capture_default_str();
+  int moves = 200;
+  app.add_option("--moves", moves, "the random pattern's number of moves (200 take about 40 simulated minutes)")
+      ->check(CLI::Range(1, 1'000'000))
+      ->capture_default_str();
   app.add_option("--duration", duration_s, "simulated seconds to run (default: the script's length)")
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--fast", fast, "virtual clock, as fast as the machine allows, deterministic");
@@ -337,14 +341,14 @@ int main(int argc, char** argv) {
                                  : pattern_name == "thinwall" ? sim::Pattern::Thinwall
                                                               : sim::Pattern::Random;
     job.script = sim::make_pattern(pattern, job.stock, home, board::sim::kOperatorSpeedMmPerS,
-                                   board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock));
+                                   board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock), moves);
   }
   // What makes the job the same job when it is resumed: recorded at its start, checked on resume.
   char job_text[400];
-  std::snprintf(job_text, sizeof job_text, "tables=%s operator=%s pattern=%s seed=%llu stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
+  std::snprintf(job_text, sizeof job_text, "tables=%s operator=%s pattern=%s seed=%llu moves=%d stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
                 tables_path.empty() ? "(baked-in hex prism)" : tables_path.c_str(),
                 operator_path.empty() ? "-" : operator_path.c_str(), operator_path.empty() ? pattern_name.c_str() : "-",
-                static_cast<unsigned long long>(seed), job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z(),
+                static_cast<unsigned long long>(seed), moves, job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z(),
                 job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
   if (!replay_path.empty()) {
     return replay(replay_path, part, job, report_path, stock_csv_path, fast ? 0.0 : speed);
@@ -512,6 +516,8 @@ int main(int argc, char** argv) {
     return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
   }
   if (journal_writer.is_open() || !journal_writer.error().empty()) {
+    // The run ended in order: said in the journal, so a resume can tell it from a kill.
+    static_cast<void>(journal_writer.append_end(result.cycles, result.safe_state));
     const bool closed = journal_writer.close();
     result.journal_path = journal_path;
     result.journal_records = journal_writer.cycle_records();

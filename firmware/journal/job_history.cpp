@@ -19,7 +19,13 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
   std::int64_t first_ns = 0, last_ns = 0;
   bool segment_has_cycle = false;
   double segment_script_s = 0.0, segment_approach_s = 0.0;
+  std::uint64_t segment_cycles = 0;
+  RunEnding ending{false, control::SafeReason::None, 0};
   const auto close_segment = [&] {
+    ending.cycles = segment_cycles;
+    history.endings.push_back(ending);
+    ending = {false, control::SafeReason::None, 0};
+    segment_cycles = 0;
     if (segment_has_cycle) {
       const double span_s = static_cast<double>(last_ns - first_ns) / 1e9 + 1e-3;  // the last cycle's period too
       history.recorded_s += span_s;
@@ -47,6 +53,7 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
     history.has_cycle = true;
     history.last_virtual_tip_mm = tip;
     ++history.cycles;
+    ++segment_cycles;
     history.touched_recorded = r.touched_triangles;
     const double force = Eigen::Vector3d(r.force_n[0], r.force_n[1], r.force_n[2]).norm();
     history.max_force_n = std::max(history.max_force_n, force);
@@ -92,6 +99,11 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
       at = next;
     }
     history.last_commanded_tip_mm = Eigen::Vector3d(c.target_tip_mm[0], c.target_tip_mm[1], c.target_tip_mm[2]);
+  };
+  visit.end = [&](std::uint64_t, control::SafeReason reason) {
+    misplaced = misplaced || !started;
+    ending.recorded = true;
+    ending.reason = reason;
   };
   visit.resume = [&](const JournalResume& resume) {
     misplaced = misplaced || !started;

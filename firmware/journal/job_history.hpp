@@ -23,6 +23,14 @@ struct RecordedFault {
   control::SafeReason reason;
 };
 
+// How a run ended: in order (its End record: finished, or in a safe state), or unrecorded (killed,
+// crashed, the power gone).
+struct RunEnding {
+  bool recorded;
+  control::SafeReason reason;  // when recorded
+  std::uint64_t cycles;        // cycle records the run left
+};
+
 struct JobHistory {
   JournalStart start;
   std::uint32_t segments = 0;           // runs recorded: 1 + the resumes
@@ -32,6 +40,7 @@ struct JobHistory {
   std::uint64_t machine_commands = 0;
   std::uint64_t machined_legs = 0;      // single-axis legs they make
   std::vector<RecordedFault> faults;    // every safe-state event, in order
+  std::vector<RunEnding> endings;       // one per run
   std::uint32_t touched_recorded = 0;   // the touched set's size at the last cycle recorded
   double max_force_n = 0.0;
   double max_offset_mm = 0.0;           // device against virtual tool, world

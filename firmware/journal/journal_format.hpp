@@ -26,6 +26,7 @@ enum class RecordType : std::uint8_t {
   Homed = 4,      // the machine homed: its tool is at home from here (written through at once)
   MachineCommand = 5,  // a target, recorded by the machine thread before it is sent (written through)
   Resume = 6,     // a resumed job's next segment starts here (its cycles count from 0 again)
+  End = 7,        // the run ended in order (a run without one was killed or crashed)
 };
 
 // Payload of Start: u32 tables' CRC-32, u32 triangle count, i64 start (ns since the Unix epoch),
@@ -42,6 +43,8 @@ inline constexpr std::uint32_t kHomedPayloadBytes = 8;
 // Payload of MachineCommand (55 bytes): u64 update, i64 time_ns, i32 motor_target[3], u8 order[3]
 // (each 0-2, or 3 for no leg), f64 target_tip_mm[3].
 inline constexpr std::uint32_t kMachineCommandPayloadBytes = 8 + 8 + 12 + 3 + 24;
+// Payload of End: u64 cycles the run made, u8 the safe reason it ended in (0: none, it finished).
+inline constexpr std::uint32_t kEndPayloadBytes = 9;
 // Payload of Resume: u32 segment (1 for the first resume), i64 start (ns since the Unix epoch),
 // f64 script_s and f64 approach_s (a simulated operator's: where its script carries on and how long
 // the way back to the cut takes first; 0 for a person), u16 program name length and its bytes.

@@ -221,9 +221,26 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         break;
       }
+      case RecordType::End: {
+        if (length != kEndPayloadBytes) {
+          result.error = at(offset) + "an end record of " + std::to_string(length) + " bytes (expected " +
+                         std::to_string(kEndPayloadBytes) + ")";
+          return result;
+        }
+        const std::uint64_t cycles = body.u64();
+        const std::uint8_t reason = body.u8();
+        if (!valid_reason(reason)) {
+          result.error = at(offset) + "an end record's reason is " + std::to_string(reason) + " (no such reason)";
+          return result;
+        }
+        if (visit.end) {
+          visit.end(cycles, static_cast<control::SafeReason>(reason));
+        }
+        break;
+      }
       default:
         result.error = at(offset) + "a record of type " + std::to_string(static_cast<int>(type)) +
-                       " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command or 6 resume)";
+                       " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command, 6 resume or 7 end)";
         return result;
     }
     ++result.records;
@@ -259,7 +276,21 @@ JournalReadResult read_journal_file(const std::string& path, const JournalVisito
     return result;
   }
   static const std::uint8_t kNothing = 0;
-  result = read_journal(mapped != nullptr ? static_cast<const std::uint8_t*>(mapped) : &kNothing, size, visit);
+  // Pages already read are given back as the reader goes, so reading gigabytes keeps memory flat.
+  JournalVisitor dropping = visit;
+  std::size_t dropped = 0;
+  constexpr std::size_t kDropEvery = 8U << 20;
+  dropping.offset = [&](std::size_t at_offset) {
+    if (at_offset - dropped >= 2 * kDropEvery) {
+      const std::size_t upto = (at_offset - kDropEvery) & ~(kDropEvery - 1);
+      ::madvise(static_cast<std::uint8_t*>(mapped) + dropped, upto - dropped, MADV_DONTNEED);
+      dropped = upto;
+    }
+    if (visit.offset) {
+      visit.offset(at_offset);
+    }
+  };
+  result = read_journal(mapped != nullptr ? static_cast<const std::uint8_t*>(mapped) : &kNothing, size, dropping);
   if (mapped != nullptr) {
     ::munmap(mapped, size);
   }

@@ -136,6 +136,18 @@ bool JournalWriter::append(const control::JournalRecord& r) {
   return buffer_.size() < kWriteOutBytes || write_out();
 }
 
+bool JournalWriter::append_end(std::uint64_t cycles, control::SafeReason reason) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ < 0 || failed_) {
+    return false;
+  }
+  ByteWriter payload;
+  payload.u64(cycles);
+  payload.u8(static_cast<std::uint8_t>(reason));
+  add_record(RecordType::End, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  return sync_locked();
+}
+
 bool JournalWriter::write_out() {
   std::size_t done = 0;
   while (done < buffer_.size()) {

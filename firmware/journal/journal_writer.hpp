@@ -58,6 +58,9 @@ class JournalWriter {
   // written after that).
   [[nodiscard]] bool append(const control::JournalRecord& record);
 
+  // The run ends in order: its End record, synced (call once, after the last cycle's record).
+  [[nodiscard]] bool append_end(std::uint64_t cycles, control::SafeReason reason);
+
   // Writes out and fsyncs when a second has passed since the last sync (now_ns: any monotonic clock).
   [[nodiscard]] bool sync_if_due(std::int64_t now_ns);
   // Writes out and fsyncs now.

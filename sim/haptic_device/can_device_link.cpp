@@ -1,6 +1,8 @@
 // The simulated device's end of the haptic CAN exchange.
 #include "sim/haptic_device/can_device_link.hpp"
 
+#include <initializer_list>
+
 #include "sim/haptic_device/wire_units.hpp"
 
 namespace stencil::sim {
@@ -20,6 +22,17 @@ void CanDeviceLink::publish(const hal::HapticSample& sample) {
   can_frame frames[3];
   if (!can::encode_pose(pose, frames[0], frames[1])) return;  // cannot happen: saturated to int24 above
   can::encode_status(status, frames[2]);
+  if (babbling_ > 0) {
+    --babbling_;
+    can_frame short_a = frames[0];
+    short_a.can_dlc = 5;
+    can_frame other_b = frames[1];
+    other_b.data[0] = static_cast<std::uint8_t>(other_b.data[0] + 1);
+    for (const can_frame& frame : {short_a, frames[0], other_b, frames[2]}) {
+      if (channel_.send(frame) != can::TransferStatus::Done) ++frames_dropped_;
+    }
+    return;
+  }
   for (const can_frame& frame : frames) {
     if (channel_.send(frame) != can::TransferStatus::Done) ++frames_dropped_;
   }

@@ -19,6 +19,11 @@ class CanDeviceLink final : public DeviceSideLink {
   // Drains at most 64 waiting frames and keeps the newest complete command.
   [[nodiscard]] CommandPoll poll(DeviceCommand& out) override;
 
+  // A babbling device (fault injection): this many publishes send bad pose frames instead of good
+  // ones (PoseA with DLC 5, then a PoseA and a PoseB whose counters disagree); the status frame, and
+  // with it the heartbeat, still goes, and commands are still taken.
+  void babble(int publishes) { babbling_ = publishes; }
+
   [[nodiscard]] const hal::socketcan::RejectionCounters& rejections() const { return assembler_.rejections(); }
   [[nodiscard]] std::uint64_t frames_dropped() const { return frames_dropped_; }
 
@@ -26,6 +31,7 @@ class CanDeviceLink final : public DeviceSideLink {
   hal::socketcan::CanChannel& channel_;
   hal::socketcan::DeviceFrameAssembler assembler_;
   std::uint64_t frames_dropped_ = 0;
+  int babbling_ = 0;
 };
 
 }  // namespace stencil::sim

@@ -185,7 +185,7 @@ OperatorScript carry_on(const OperatorScript& script, double from_s, const Eigen
 
 OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
                             double speed_mm_per_s, double scale, std::uint64_t seed,
-                            const std::function<double(double, double)>& touch_tip) {
+                            const std::function<double(double, double)>& touch_tip, int random_moves) {
   OperatorScript script;
   const Eigen::Vector3d& low = stock.low_mm;
   const Eigen::Vector3d& high = stock.high_mm;
@@ -234,7 +234,7 @@ OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen:
     case Pattern::Random: {
       std::mt19937_64 random(seed);
       std::uniform_real_distribution<double> unit(0.0, 1.0);
-      for (int i = 0; i < 200; ++i) {
+      for (int i = 0; i < random_moves; ++i) {
         const Eigen::Vector3d to(low.x() + unit(random) * (high.x() - low.x()), low.y() + unit(random) * (high.y() - low.y()),
                                  low.z() - 1.0 + unit(random) * (above - low.z() + 1.0));
         walk_to(script, to, (0.5 + 2.0 * unit(random)) * speed_mm_per_s, scale);

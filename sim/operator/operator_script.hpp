@@ -44,10 +44,11 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
 //   pressed 1 mm into its walls, for the cusps the passes leave between them on the walls;
 // plunge: straight down to the floor at points 2 mm apart, through the part where it is there;
 // thinwall: fast sweeps straight across the stock at several heights, through whatever is there;
-// random: a random walk over and into the stock (seeded).
+// random: a random walk over and into the stock (seeded), `random_moves` moves (200: about 40 minutes).
 [[nodiscard]] OperatorScript make_pattern(Pattern pattern, const StockBox& stock, const Eigen::Vector3d& home_world_mm,
                                           double speed_mm_per_s, double device_mm_per_world_mm, std::uint64_t seed,
-                                          const std::function<double(double, double)>& touch_tip);
+                                          const std::function<double(double, double)>& touch_tip,
+                                          int random_moves = 200);
 
 // The way back into a job that stopped (a resume): from `home` across at home's height to above
 // `rejoin` (world; along x, then y), straight down to it, then to where `script` was at `from_s`, and on with the rest

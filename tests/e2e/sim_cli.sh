@@ -55,14 +55,14 @@ at_most() {
 
 # journal_size_ok JOURNAL REPORT EVENTS WHAT: the journal is exactly the file header, its start
 # record, a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command and
-# an 18-byte record per safe-state event (EVENTS), as the report counts them.
+# an 18-byte record per safe-state event (EVENTS), as the report counts them, and the 18-byte end.
 journal_size_ok() {
   local journal=$1 report=$2 events=$3 what=$4 start cycles commands size expected
   start=$(od -An -tu4 -j12 -N4 "$journal" | tr -d ' ')
   cycles=$(json_number "$report" cycles)
   commands=$(json_number "$report" machine_records)
   size=$(stat -c %s "$journal")
-  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 18 * events))
+  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 18 * events + 18))
   [ "$size" -eq "$expected" ] ||
     fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $events safe-state events)"
   # Every target sent is in the journal (recorded before it is sent).

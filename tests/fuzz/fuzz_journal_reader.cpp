@@ -75,6 +75,10 @@ int read_and_check(const std::uint8_t* data, std::size_t size) {
         require(resume.program.size() <= 256);
         ++visits;
       },
+      [&](std::uint64_t, stencil::control::SafeReason reason) {
+        require(static_cast<int>(reason) <= static_cast<int>(stencil::control::SafeReason::Stopped));
+        ++visits;
+      },
       [&](std::size_t offset) { require(offset >= stencil::journal::kFileHeaderBytes && offset < size); }};
   const stencil::journal::JournalReadResult read = stencil::journal::read_journal(data, size, visitor);
   require(read.ok == read.error.empty());

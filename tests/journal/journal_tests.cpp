@@ -93,6 +93,7 @@ struct Seen {
   std::vector<std::int64_t> homings;
   std::vector<stencil::control::MachineCommandRecord> commands;
   std::vector<JournalResume> resumes;
+  std::vector<std::pair<std::uint64_t, SafeReason>> endings;
   JournalStart start;
   JournalVisitor visitor() {
     return {[this](const JournalStart& s) {
@@ -104,6 +105,7 @@ struct Seen {
             [this](std::int64_t t) { homings.push_back(t); },
             [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); },
             [this](const JournalResume& r) { resumes.push_back(r); },
+            [this](std::uint64_t c, SafeReason reason) { endings.emplace_back(c, reason); },
             {}};
   }
 };
@@ -358,6 +360,7 @@ TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   resume.program = "stencil-sim";
   CHECK_TRUE(writer.open_to_resume(file.path, first.good_bytes, resume));
   CHECK_TRUE(writer.append(record_of(0)));
+  CHECK_TRUE(writer.append_end(1, SafeReason::None));
   CHECK_TRUE(writer.close());
   Seen after;
   const JournalReadResult second = read_journal_file(file.path, after.visitor());
@@ -370,6 +373,9 @@ TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   CHECK(after.resumes[0].script_s == 12.5 && after.resumes[0].approach_s == 40.25);
   STRCMP_EQUAL("stencil-sim", after.resumes[0].program.c_str());
   LONGS_EQUAL(0, after.cycles.back().cycle);
+  LONGS_EQUAL(1, after.endings.size());  // the first run was cut off: only the second ended in order
+  LONGS_EQUAL(1, after.endings[0].first);
+  CHECK(after.endings[0].second == SafeReason::None);
 }
 
 TEST(Journal, AMachineCommandThatNamesNoAxisOrAnInfiniteTargetIsAnErrorNamingTheOffset) {
