@@ -68,9 +68,31 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   if (model.ready()) {
     machine->keep_stock_model(&model);
   }
+  std::unique_ptr<journal::MachineJournal> machine_journal;
+  if (job.journal != nullptr) {
+    machine_journal = std::make_unique<journal::MachineJournal>(*job.journal);
+    machine->record_to(machine_journal.get());
+  }
+  if (!job.resume_from.empty()) {
+    const journal::HistoryRebuild rebuild{
+        [&](const Eigen::Vector3d& tip) { controller->recall_touched(tip); },
+        [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+          if (model.ready()) {
+            model.cut(from, to);
+          }
+        }};
+    std::string history_error;
+    if (!journal::read_job_history(job.resume_from, part.header.crc32, part.header.triangle_count, frames, rebuild,
+                                   result.earlier, history_error, job.resume_bytes)) {
+      result.error = "--resume: " + history_error;
+      return result;
+    }
+    result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
+  }
   hal::Clock& clock = *job.machine_clock;
   if (!machine->start(clock.now_ns() + 120'000'000'000)) {
-    result.error = "the machine did not start (wake, home, spindle on)";
+    result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
+                                            : "the machine did not start (wake, home, spindle on)";
     return result;
   }
   result.started = true;
@@ -176,8 +198,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   result.wakeup_max_us = static_cast<double>(statistics.wakeup_latency.max_ns()) / 1000.0;
   result.compute_p99_us = statistics.compute.quantile_us(0.99);
   result.compute_max_us = static_cast<double>(statistics.compute.max_ns()) / 1000.0;
-  result.max_force_n = controller->max_force_n();
-  result.max_offset_mm = controller->max_offset_mm();
+  result.max_force_n = std::max(controller->max_force_n(), result.earlier.max_force_n);  // the whole job
+  result.max_offset_mm = std::max(controller->max_offset_mm(), result.earlier.max_offset_mm);
   result.machine_updates = machine->statistics().updates;
   result.machine_max_lag_mm = machine->statistics().max_lag_mm;
   result.model_removed_mm3 = model.ready() ? model.removed_volume_mm3() : 0.0;

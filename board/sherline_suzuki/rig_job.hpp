@@ -13,6 +13,7 @@
 
 #include "firmware/control/commanded_stock.hpp"
 #include "firmware/control/safe_state.hpp"
+#include "firmware/journal/job_history.hpp"
 #include "firmware/journal/journal_writer.hpp"
 #include "firmware/motion/machine_frames.hpp"
 #include "firmware/tables/part_tables.hpp"
@@ -46,7 +47,11 @@ struct RigJob {
   hal::Clock* machine_clock = nullptr;  // the link's clock: the machine thread paces on it
   WorkOffset offset;
   control::StockBlock stock{};          // for the controller's model of the machined stock
-  journal::JournalWriter* journal = nullptr;
+  journal::JournalWriter* journal = nullptr;  // every cycle's record and machine command goes here, when given
+  // A resumed job: its journal's first resume_bytes (the job so far). The touched set and the model
+  // of the machined stock are rebuilt from it before the machine homes again.
+  std::string resume_from;
+  std::size_t resume_bytes = 0;
   const std::atomic<bool>* interrupted = nullptr;  // SIGINT/SIGTERM: a stop command to the cycle
   double duration_s = 0.0;                          // 0: until interrupted or a safe state
   // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
@@ -76,12 +81,15 @@ struct RigResult {
   std::uint64_t safe_state_entries = 0;
   std::uint64_t resets_accepted = 0, resets_refused = 0;
   std::string journal_error;
+  journal::JobHistory earlier;        // the job before this run (earlier.segments 0: a fresh job)
+  std::uint32_t touched_rebuilt = 0;  // the touched set rebuilt from it (earlier.touched_recorded: as recorded)
 };
 
-// Homes the machine, then runs until the duration or an interrupt; on the way out the machine is
-// held and stopped. A fault's safe state (zero force, the mill held and stopped) keeps the cycle
-// running until a reset restores the force (the mill stays stopped: re-homing to resume is not
-// built) or the run is stopped. Blocks.
+// Homes the machine (a resumed job: after rebuilding what the journal says was touched and cut), then
+// runs until the duration or an interrupt; on the way out the machine is held and stopped. A fault's
+// safe state (zero force, the mill held and stopped) keeps the cycle running until a reset restores
+// the force (the mill stays stopped: carrying on means a new run with --resume, which homes again)
+// or the run is stopped. Blocks.
 [[nodiscard]] RigResult run_rig(const RigJob& job, const PeriodicRunner& runner);
 
 }  // namespace stencil::board::sherline_suzuki

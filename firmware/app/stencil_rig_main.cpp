@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -25,6 +26,7 @@
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/app/realtime_thread.hpp"
 #include "firmware/app/rt_readiness.hpp"
+#include "firmware/journal/job_history.hpp"
 #include "firmware/journal/journal_writer.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
@@ -152,7 +154,18 @@ int main(int argc, char** argv) {
   std::string report_path;
   app.add_option("--report", report_path, "write the run's figures here as JSON");
   std::string journal_path;
-  app.add_option("--journal", journal_path, "record the job here (every cycle's sample and tool, safe-state events)");
+  app.add_option("--journal", journal_path,
+                 "record the job here: every cycle's sample, virtual tool and force, every machine command (written "
+                 "before it is sent), every safe-state event (default: stencil-rig-YYYYMMDD-HHMMSS.journal in the "
+                 "current folder, named after the start time)");
+  bool no_journal = false;
+  app.add_flag("--no-journal", no_journal, "record no journal (the job cannot be resumed)");
+  std::string resume_path;
+  app.add_option("--resume", resume_path,
+                 "carry on the job this journal recorded (after a crash, a kill or a safe state), with the same --tables, "
+                 "--work-offset, stick-outs and --stock: the touched set and the model of the machined stock are rebuilt "
+                 "from it, the mill homes again (Z first, out of the stock) and the cut carries on from wherever the "
+                 "operator takes the handle; the journal carries on in the same file and the report covers the whole job");
   double duration_s = 0.0;
   app.add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
@@ -259,14 +272,56 @@ int main(int argc, char** argv) {
     device = can_device.get();
   }
 
+  // What makes the job the same job when it is resumed: recorded at its start, checked on resume.
+  char job_text[300];
+  std::snprintf(job_text, sizeof job_text,
+                "work-offset=%.6f,%.6f,%.6f tool-stick-out=%.6f reference-stick-out=%.6f stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
+                offset.home_world_mm.x(), offset.home_world_mm.y(), offset.home_world_mm.z(), offset.tool_stick_out_mm,
+                offset.reference_stick_out_mm, stock.low_mm.x(), stock.low_mm.y(), stock.low_mm.z(), stock.high_mm.x(),
+                stock.high_mm.y(), stock.high_mm.z());
   journal::JournalWriter journal_writer;
-  if (!journal_path.empty()) {
+  journal::JobHistory history;
+  const auto now = std::chrono::system_clock::now();
+  const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
+  if (!resume_path.empty()) {
+    if (!journal_path.empty() || no_journal) {
+      return fail(kExitBadInput, "--resume carries on in the journal it resumes: no --journal or --no-journal with it");
+    }
+    std::string history_error;
+    if (!journal::read_job_history(resume_path, part.header.crc32, part.header.triangle_count,
+                                   board::sherline_suzuki::rig_frames(offset), {}, history, history_error)) {
+      return fail(kExitBadInput, "--resume: " + history_error);
+    }
+    if (history.start.job != job_text) {
+      return fail(kExitBadInput, "--resume " + resume_path + ": recorded for another job (" + history.start.job +
+                                     "); this one is " + job_text + ": resume with the recorded job's options");
+    }
+    journal::JournalResume resume;
+    resume.segment = history.segments;
+    resume.unix_time_ns = now_ns;
+    resume.program = "stencil-rig";
+    if (!journal_writer.open_to_resume(resume_path, history.good_bytes, resume)) {
+      return fail(kExitBadInput, journal_writer.error());
+    }
+    std::printf("stencil-rig: resuming %s: %u run(s), %llu cycles, %zu safe state(s), %llu machine commands%s\n",
+                resume_path.c_str(), history.segments, static_cast<unsigned long long>(history.cycles), history.faults.size(),
+                static_cast<unsigned long long>(history.machine_commands),
+                history.tail.empty() ? "" : ("; its torn tail ignored (" + history.tail + ")").c_str());
+  } else if (!no_journal) {
+    if (journal_path.empty()) {
+      const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
+      std::tm local{};
+      localtime_r(&seconds, &local);
+      char name[64];
+      std::strftime(name, sizeof name, "stencil-rig-%Y%m%d-%H%M%S.journal", &local);
+      journal_path = name;
+    }
     journal::JournalStart start;
     start.tables_crc32 = part.header.crc32;
     start.triangle_count = part.header.triangle_count;
-    start.unix_time_ns =
-        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
+    start.unix_time_ns = now_ns;
     start.program = "stencil-rig";
+    start.job = job_text;
     if (!journal_writer.open(journal_path, start)) {
       return fail(kExitBadInput, journal_writer.error());
     }
@@ -291,6 +346,10 @@ int main(int argc, char** argv) {
   job.offset = offset;
   job.stock = stock;
   job.journal = journal_writer.is_open() ? &journal_writer : nullptr;
+  if (!resume_path.empty()) {
+    job.resume_from = resume_path;
+    job.resume_bytes = history.good_bytes;
+  }
   job.interrupted = &interrupted;
   job.duration_s = duration_s;
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
@@ -308,8 +367,14 @@ int main(int argc, char** argv) {
         refused = setup.refused.empty() ? "" : "--require-rt: " + setup.refused;
         return setup.refused.empty();
       });
+  if (journal_writer.is_open() && result.started) {
+    static_cast<void>(journal_writer.append_end(result.cycles, result.safe_state));  // an orderly end, not a kill
+  }
   const bool journal_closed = !journal_writer.is_open() || journal_writer.close();
   if (!result.started) {
+    if (resume_path.empty() && !journal_path.empty()) {
+      std::remove(journal_path.c_str());  // nothing ran: a fresh journal of nothing goes (a resumed one stays)
+    }
     const std::string link_error = link.last_error();
     return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));
   }
@@ -345,7 +410,13 @@ int main(int argc, char** argv) {
         {"first_fault", result.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)
                                                                           : nlohmann::json(control::safe_reason_name(result.first_fault))},
         {"resets", {{"accepted", result.resets_accepted}, {"refused", result.resets_refused}}},
-        {"run_s", result.run_s}};
+        {"run_s", result.run_s},
+        {"job", {{"runs", result.earlier.segments + 1},
+                 {"total_cycles", result.earlier.cycles + result.cycles},
+                 {"earlier_safe_states", result.earlier.faults.size()},
+                 {"earlier_machine_commands", result.earlier.machine_commands},
+                 {"touched_recorded", result.earlier.touched_recorded},
+                 {"touched_rebuilt", result.touched_rebuilt}}}};
     std::ofstream out(report_path);
     if (!(out << report.dump(2) << "\n")) {
       return fail(kExitBadInput, report_path + ": cannot be written");

@@ -98,6 +98,8 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       enter_safe_state(SafeReason::MachineFault);
     } else if (event.kind == MachineEventKind::JournalFailed) {
       enter_safe_state(SafeReason::JournalFailed);
+    } else if (event.kind == MachineEventKind::Backlog) {
+      backlog_percent_ = event.fault;
     }
   }
 }
@@ -208,6 +210,12 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   engine::ContactResult contact{engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   engine::HapticOutput output{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false};
   if (safe_reason_ == SafeReason::None && usable) {
+    // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
+    // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
+    const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
+    if (std::isfinite(config_.max_axis_move_mm) && std::isfinite(config_.max_total_move_mm)) {
+      tool_.limit_speed(backlog_scale * config_.max_axis_move_mm, backlog_scale * config_.max_total_move_mm);
+    }
     contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
     const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
     telemetry.remediation = moved.status;

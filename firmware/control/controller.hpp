@@ -130,6 +130,7 @@ class Controller {
   hal::MonotonicNs ramp_start_ns_ = 0;     // force ramps in from here after a reset (or the start)
   bool ramping_ = true;
   int consecutive_overruns_ = 0;
+  double backlog_percent_ = 0.0;           // the mill's path still to follow, from its last update
   hal::MonotonicNs step_start_ns_ = 0;
   hal::MonotonicNs step_deadline_ns_ = 0;
   hal::MonotonicNs next_deadline_ns_ = 0;  // from the last finish(): when the next step was due

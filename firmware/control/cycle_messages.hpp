@@ -60,11 +60,12 @@ enum class MachineEventKind : std::uint8_t {
   Fault,    // the link latched a fault: the cycle enters the safe state
   Stopped,  // the machine is stopped (after a safe state): for the record
   JournalFailed,  // a target could not be recorded, so it was not sent: the cycle enters the safe state
+  Backlog,        // how much of the path the mill has still to follow (each update): the cycle slows the tool
 };
 
 struct MachineEvent {
   MachineEventKind kind;
-  std::uint8_t fault;  // hal::MachineFault, for Fault
+  std::uint8_t fault;  // hal::MachineFault, for Fault; the path's fill in percent, for Backlog
 };
 
 // About 20 Hz is enough for people; the cycle pushes every cycle and a full ring drops (counted).

@@ -58,6 +58,13 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   if (state_ != MachineSideState::Cutting) {
     return;
   }
+  // The backlog, so the cycle can slow the virtual tool before the path fills (which is a fault).
+  // Only while the ring has room to spare: a fault's event must always find a slot.
+  if (to_cycle_.size() < MachineEventRing::capacity() / 2) {
+    const auto percent = static_cast<std::uint8_t>(
+        std::min<std::size_t>(100, 100 * planner_.path_size() / motion::MachinePlanner::kPathCapacity));
+    static_cast<void>(to_cycle_.push({MachineEventKind::Backlog, percent}));
+  }
   if (safe_state) {
     stop(update_deadline_ns, false);
     return;

@@ -427,3 +427,29 @@ TEST(Controller, AResetWhileTheDeviceLinkIsStillDownIsRefused) {
   CHECK(bench.controller->last_reset() == ResetOutcome::DeviceNotReady);
   CHECK(bench.controller->safe_reason() == SafeReason::DeviceFault);
 }
+
+// The mill's backlog slows the virtual tool: at full speed below half the path, not at all from
+// 90 % (the mill catches up instead of the path filling, which would be a machine fault), and back
+// to full speed once the backlog drains.
+TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtNinetyPercentHoldsIt) {
+  ControllerConfig c = config();
+  c.max_axis_move_mm = 1e-3;
+  c.max_total_move_mm = 1e-3;
+  Bench bench(c);
+  bench.cycles(5);
+  const auto moved_in_a_cycle = [&bench](std::uint8_t backlog_percent) {
+    CHECK(bench.machine_events.push({MachineEventKind::Backlog, backlog_percent}));
+    const Eigen::Vector3d before = bench.controller->virtual_tip_mm();
+    CHECK(bench.cycle() == CycleStatus::Running);
+    return (bench.controller->virtual_tip_mm() - before).cwiseAbs().sum();
+  };
+  // The hand drawn well ahead along -x, faster than the tool may follow: it goes at its limit.
+  bench.move_device_to(kHomeDevice - Eigen::Vector3d(100.0, 0.0, 0.0), 500.0);
+  DOUBLES_EQUAL(1e-3, moved_in_a_cycle(10), 1e-12);
+  DOUBLES_EQUAL(1e-3, moved_in_a_cycle(50), 1e-12);
+  DOUBLES_EQUAL(0.5e-3, moved_in_a_cycle(70), 1e-12);
+  DOUBLES_EQUAL(0.0, moved_in_a_cycle(90), 0.0);
+  DOUBLES_EQUAL(0.0, moved_in_a_cycle(100), 0.0);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);  // slowed, not a fault
+  DOUBLES_EQUAL(1e-3, moved_in_a_cycle(20), 1e-12);
+}

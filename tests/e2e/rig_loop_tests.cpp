@@ -5,12 +5,17 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <string>
 #include <thread>
+
+#include <unistd.h>
 
 #include <pthread.h>
 #include <sched.h>
 
 #include "board/sherline_suzuki/rig_job.hpp"
+#include "firmware/journal/job_history.hpp"
 #include "firmware/app/realtime_thread.hpp"
 #include "firmware/tables/table_loader.hpp"
 #include "hal/cy545/cy545_link.hpp"
@@ -216,4 +221,63 @@ TEST(RigLoop, APoseJumpIsASafeStateThatAResetLeavesOnceTheHandleIsHeldStill) {
   LONGS_EQUAL(1, result.resets_accepted);
   STRCMP_EQUAL("stopped", control::safe_reason_name(result.safe_state));
   CHECK_FALSE(rig.spindle_on());  // stopped at the jump, and it stays stopped
+}
+
+// A job carried on from its journal (as after a kill): the run before is rebuilt from the record
+// (its cycles, its machine commands, the touched set and the model of the stock it cut), the mill
+// homes again before it moves, and the journal goes on in the same file with the second run's.
+TEST(RigLoop, AJobCarriedOnFromItsJournalRebuildsWhatWasCutAndHomesAgain) {
+  char name[] = "/tmp/rig_loop_journal_XXXXXX";
+  const int fd = mkstemp(name);
+  CHECK(fd >= 0);
+  close(fd);
+  const std::string path = name;
+  rig::RigResult first;
+  {
+    FakeRig rig;
+    journal::JournalWriter writer;
+    journal::JournalStart start;
+    start.tables_crc32 = rig.part.header.crc32;
+    start.triangle_count = rig.part.header.triangle_count;
+    start.program = "rig_loop_tests";
+    CHECK_TRUE(writer.open(path, start));
+    rig::RigJob job = rig.job(1.5);
+    job.stock = {{0.0, 0.0, 0.0}, {50.0, 25.0, 25.5}};  // the 1 mm draw at home's height cuts its top
+    job.journal = &writer;
+    first = rig::run_rig(job, unprivileged_runner());
+    CHECK_TRUE(first.started);
+    CHECK_TRUE(writer.close());  // no End record: as if the run had been killed
+  }
+  CHECK(first.model_removed_mm3 > 0.0);
+  journal::JobHistory before;
+  std::string error;
+  FakeRig rig;
+  const motion::MachineFrames frames = rig::rig_frames({});
+  CHECK_TRUE(journal::read_job_history(path, rig.part.header.crc32, rig.part.header.triangle_count, frames, {}, before, error));
+  LONGS_EQUAL(1, before.homings);
+  CHECK(before.machine_commands >= first.machine_updates && before.machine_commands > 0);
+  CHECK_FALSE(before.endings[0].recorded);
+  journal::JournalWriter writer;
+  journal::JournalResume resume;
+  resume.segment = 1;
+  CHECK_TRUE(writer.open_to_resume(path, before.good_bytes, resume));
+  rig::RigJob job = rig.job(1.0);
+  job.stock = {{0.0, 0.0, 0.0}, {50.0, 25.0, 25.5}};
+  job.journal = &writer;
+  job.resume_from = path;
+  job.resume_bytes = before.good_bytes;
+  const rig::RigResult second = rig::run_rig(job, unprivileged_runner());
+  CHECK_TRUE(writer.close());
+  STRCMP_EQUAL("", second.error.c_str());
+  LONGS_EQUAL(1, second.earlier.segments);
+  LONGS_EQUAL(before.cycles, second.earlier.cycles);
+  LONGS_EQUAL(second.earlier.touched_recorded, second.touched_rebuilt);
+  // The model starts from what the first run cut (the second repeats the same draw).
+  CHECK(second.model_removed_mm3 >= first.model_removed_mm3 - 1e-9);
+  journal::JobHistory after;
+  CHECK_TRUE(journal::read_job_history(path, rig.part.header.crc32, rig.part.header.triangle_count, frames, {}, after, error));
+  LONGS_EQUAL(2, after.segments);
+  LONGS_EQUAL(2, after.homings);  // homed again before anything moved
+  CHECK(after.cycles > before.cycles);
+  std::remove(path.c_str());
 }

@@ -190,7 +190,7 @@ case_random() {
 # The same inputs give the same report, apart from the wall-clock fields.
 case_same_report_twice() {
   strip_wall_clock() {
-    awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
   run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report first.json
   expect_status 0
@@ -205,7 +205,7 @@ case_same_report_twice() {
 # carry positions to the micrometre, so the two give the same report, and neither gouges.
 case_pio_and_can_give_the_same_result() {
   strip_wall_clock() {
-    awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
   run_sim --fast --pattern plunge --duration 90 --haptic-transport pio --no-journal --report pio.json
   expect_status 0
@@ -245,7 +245,7 @@ case_refuses_to_run_without_a_clock() {
 # --fast, timing aside, and no faster than N allows.
 case_speed_n_is_fast_mode_paced() {
   strip_wall_clock() {
-    awk '/"compute_us": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
   }
   run_sim --fast --pattern plunge --duration 12 --no-journal --report fast.json
   expect_status 0
