@@ -552,6 +552,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   control::MicrosecondHistogram compute;
   double next_progress_s = 10.0;
   bool stop_after_update = false;
+  bool replay_done = false;
   for (;;) {
     if (cycle_ns >= next_update_ns && cycle_ns >= machine_clock.now_ns()) {
       machine_clock.sleep_until_ns(cycle_ns);
@@ -561,7 +562,11 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
         result.machine_stopped_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
       }
       next_update_ns += kUpdateNs;
-      if (stop_after_update) {
+      // After a safe state: once the mill is stopped and the device is seen to drive no force (over a
+      // wire it takes the zero command at its next millisecond), or a tenth of a second on.
+      const double now_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
+      if (stop_after_update && (replay_done || result.safe_state_s < 0.0 || result.force_zero_s >= 0.0 ||
+                                now_s - result.safe_state_s > 0.1)) {
         break;
       }
       continue;
@@ -579,6 +584,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const control::JournalRecord* recorded = nullptr;
     if (job.replay != nullptr) {
       if (result.replay_cycles == job.replay->size()) {
+        replay_done = true;
         stop_after_update = true;  // the record ends here: one more machine update, then the end
         next_update_ns = std::min(next_update_ns, cycle_ns);
         continue;
@@ -630,8 +636,10 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     }
     cycle_ns += kPeriodNs;
     if (safe) {
-      stop_after_update = true;  // one more machine update: it holds and stops the mill
-      next_update_ns = std::min(next_update_ns, cycle_ns);
+      if (!stop_after_update) {
+        stop_after_update = true;  // a machine update at once: it holds and stops the mill
+        next_update_ns = std::min(next_update_ns, cycle_ns);
+      }
       continue;
     }
     if (job.pace > 0.0 && controller->statistics().cycles % 10 == 0) {
