@@ -68,6 +68,12 @@ while [ "$done" -eq 0 ]; do
     # SIGKILL at a random moment: while it rebuilds the job, or mid-cut.
     "$sim" "${job[@]}" "${resume[@]}" --haptic-transport "$transport" --report "$report" >"run-$run.txt" 2>&1 &
     pid=$!
+    # Once its journal is open (the run has its Start or Resume record), at a random moment.
+    for _ in $(seq 6000); do
+      grep -q '^journal: ' "run-$run.txt" 2>/dev/null && break
+      kill -0 "$pid" 2>/dev/null || break
+      sleep 0.1
+    done
     sleep "$(awk -v r=$RANDOM -v g="$gap_s" 'BEGIN { printf "%.2f", 0.5 + (r / 32768.0) * g / 50.0 }')"
     kill -KILL "$pid" 2>/dev/null
     wait "$pid"

@@ -552,7 +552,6 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   control::MicrosecondHistogram compute;
   double next_progress_s = 10.0;
   bool stop_after_update = false;
-  bool replay_done = false;
   for (;;) {
     if (cycle_ns >= next_update_ns && cycle_ns >= machine_clock.now_ns()) {
       machine_clock.sleep_until_ns(cycle_ns);
@@ -565,7 +564,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       // After a safe state: once the mill is stopped and the device is seen to drive no force (over a
       // wire it takes the zero command at its next millisecond), or a tenth of a second on.
       const double now_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
-      if (stop_after_update && (replay_done || result.safe_state_s < 0.0 || result.force_zero_s >= 0.0 ||
+      if (stop_after_update && (result.safe_state_s < 0.0 || result.force_zero_s >= 0.0 ||
                                 now_s - result.safe_state_s > 0.1)) {
         break;
       }
@@ -584,10 +583,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     const control::JournalRecord* recorded = nullptr;
     if (job.replay != nullptr) {
       if (result.replay_cycles == job.replay->size()) {
-        replay_done = true;
-        stop_after_update = true;  // the record ends here: one more machine update, then the end
-        next_update_ns = std::min(next_update_ns, cycle_ns);
-        continue;
+        break;  // the record ends here, and so does the replay
       }
       recorded = &(*job.replay)[result.replay_cycles];
       replay_device.set(*recorded);
@@ -637,8 +633,13 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     cycle_ns += kPeriodNs;
     if (safe) {
       if (!stop_after_update) {
-        stop_after_update = true;  // a machine update at once: it holds and stops the mill
-        next_update_ns = std::min(next_update_ns, cycle_ns);
+        stop_after_update = true;
+        // A machine update at once: it holds and stops the mill. Unless the safe state came in
+        // finish() (the overrun watchdog): this cycle's handoff went without it, and only the next
+        // cycle's carries it to the machine side (and its record to the journal).
+        if (status == control::CycleStatus::SafeState) {
+          next_update_ns = std::min(next_update_ns, cycle_ns);
+        }
       }
       continue;
     }

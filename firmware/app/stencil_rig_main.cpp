@@ -372,8 +372,11 @@ int main(int argc, char** argv) {
   }
   const bool journal_closed = !journal_writer.is_open() || journal_writer.close();
   if (!result.started) {
+    // Nothing ran: a fresh journal of nothing goes, a resumed one goes back to the job it held.
     if (resume_path.empty() && !journal_path.empty()) {
-      std::remove(journal_path.c_str());  // nothing ran: a fresh journal of nothing goes (a resumed one stays)
+      std::remove(journal_path.c_str());
+    } else if (!resume_path.empty() && ::truncate(resume_path.c_str(), static_cast<off_t>(history.good_bytes)) != 0) {
+      std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", resume_path.c_str());
     }
     const std::string link_error = link.last_error();
     return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));

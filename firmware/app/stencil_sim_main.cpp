@@ -344,12 +344,17 @@ int main(int argc, char** argv) {
                                    board::sim::kDeviceMmPerWorldMm, seed, board::sim::touch_tip_of(part, job.stock), moves);
   }
   // What makes the job the same job when it is resumed: recorded at its start, checked on resume.
-  char job_text[400];
-  std::snprintf(job_text, sizeof job_text, "tables=%s operator=%s pattern=%s seed=%llu moves=%d stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
-                tables_path.empty() ? "(baked-in hex prism)" : tables_path.c_str(),
-                operator_path.empty() ? "-" : operator_path.c_str(), operator_path.empty() ? pattern_name.c_str() : "-",
-                static_cast<unsigned long long>(seed), moves, job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z(),
-                job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
+  char numbers[200];
+  std::snprintf(numbers, sizeof numbers, " seed=%llu moves=%d stock=%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
+                static_cast<unsigned long long>(seed), moves, job.stock.low_mm.x(), job.stock.low_mm.y(),
+                job.stock.low_mm.z(), job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
+  const std::string job_text = "tables=" + (tables_path.empty() ? std::string("(baked-in hex prism)") : tables_path) +
+                               " operator=" + (operator_path.empty() ? std::string("-") : operator_path) +
+                               " pattern=" + (operator_path.empty() ? pattern_name : std::string("-")) + numbers;
+  if (job_text.size() > 1024) {
+    return bad_input("--tables and --operator: paths too long to record in the journal (" + std::to_string(job_text.size()) +
+                     " bytes of the job; at most 1024)");
+  }
   if (!replay_path.empty()) {
     return replay(replay_path, part, job, report_path, stock_csv_path, fast ? 0.0 : speed);
   }
@@ -429,6 +434,14 @@ int main(int argc, char** argv) {
       std::remove(path.c_str());  // made only to find out: a refused run leaves nothing behind
     }
   }
+  std::FILE* device_log = nullptr;
+  if (!device_log_path.empty()) {
+    device_log = std::fopen(device_log_path.c_str(), "w");
+    if (device_log == nullptr) {
+      return bad_input(device_log_path + ": cannot be written");
+    }
+    job.device_process_log = device_log;
+  }
   journal::JournalWriter journal_writer;
   const auto now = std::chrono::system_clock::now();
   const std::int64_t now_ns = std::chrono::duration_cast<std::chrono::nanoseconds>(now.time_since_epoch()).count();
@@ -441,6 +454,7 @@ int main(int argc, char** argv) {
     journal_path = resume_path;
     job.journal = &journal_writer;
     std::printf("journal: %s (carried on)\n", journal_path.c_str());
+    std::fflush(stdout);
   } else if (!no_journal) {
     if (journal_path.empty()) {
       const std::time_t seconds = std::chrono::system_clock::to_time_t(now);
@@ -461,14 +475,7 @@ int main(int argc, char** argv) {
     }
     job.journal = &journal_writer;
     std::printf("journal: %s\n", journal_path.c_str());
-  }
-  std::FILE* device_log = nullptr;
-  if (!device_log_path.empty()) {
-    device_log = std::fopen(device_log_path.c_str(), "w");
-    if (device_log == nullptr) {
-      return bad_input(device_log_path + ": cannot be written");
-    }
-    job.device_process_log = device_log;
+    std::fflush(stdout);
   }
   job.interrupted = &interrupted;
   board::sim::SimResult result;
@@ -505,9 +512,13 @@ int main(int argc, char** argv) {
     std::fclose(device_log);
   }
   if (!result.started) {
-    // Nothing was run: what this run created for its outputs goes too (a resumed journal stays).
+    // Nothing was run: what this run created for its outputs goes too, and a resumed journal goes
+    // back to what it held (no Resume record of a run that never ran).
+    static_cast<void>(journal_writer.close());
     if (!journal_path.empty() && resume_path.empty()) {
       std::remove(journal_path.c_str());
+    } else if (!resume_path.empty() && ::truncate(resume_path.c_str(), static_cast<off_t>(history.good_bytes)) != 0) {
+      std::fprintf(stderr, "stencil-sim: %s: could not be cut back to the job it held\n", resume_path.c_str());
     }
     if (!trace_path.empty()) {
       std::remove(trace_path.c_str());

@@ -66,6 +66,7 @@ ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
   ramp_start_ns_ = now_ns;
   ramping_ = true;
   consecutive_overruns_ = 0;
+  backlog_percent_ = 0.0;  // the machine side stopped with the safe state: its last backlog says nothing now
   return ResetOutcome::Accepted;
 }
 

@@ -11,12 +11,13 @@ MachineSide::MachineSide(const tables::PartTables& part, hal::MachineLink& link,
       commanded_tip_mm_(frames.home_world_mm) {}
 
 bool MachineSide::start(hal::MonotonicNs deadline_ns) {
-  if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
-    return false;
-  }
-  // Homed: the tool is at home whatever the record said before (a resumed job starts here).
+  // The homing is in the record before anything moves: from it on the tool is at home, whatever the
+  // record said before (a resumed job starts here). Not recorded: nothing moves, the spindle stays off.
   if (recorder_ != nullptr && !recorder_->homed(deadline_ns)) {
     record_failed_ = true;
+    return false;
+  }
+  if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
     return false;
   }
   planner_.homed({{0, 0, 0}}, link_.home_approach());

@@ -27,7 +27,7 @@ bool JournalWriter::fail(const std::string& what, int error_number) {
 }
 
 bool JournalWriter::open(const std::string& path, const JournalStart& start) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   path_ = path;
   fd_ = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd_ < 0) {
@@ -48,11 +48,11 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
   payload.u16(static_cast<std::uint16_t>(job_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(start.job.data()), job_length);
   add_record(RecordType::Start, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync_locked();
+  return sync_locked(lock);
 }
 
 bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_bytes, const JournalResume& resume) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   path_ = path;
   fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
   if (fd_ < 0) {
@@ -73,7 +73,7 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
   add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync_locked();
+  return sync_locked(lock);
 }
 
 bool JournalWriter::append_homed(std::int64_t time_ns) {
@@ -95,8 +95,11 @@ bool JournalWriter::append_machine_command(const control::MachineCommandRecord& 
   ByteWriter payload;
   encode_machine_command(record, payload);
   add_record(RecordType::MachineCommand, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  if (!write_out()) {  // in the file before the mill is sent it: a crash of this program cannot lose it
+    return false;
+  }
   ++machine_records_;
-  return write_out();  // in the file before the mill is sent it: a crash of this program cannot lose it
+  return true;
 }
 
 void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length) {
@@ -114,7 +117,7 @@ void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std
 }
 
 bool JournalWriter::append(const control::JournalRecord& r) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -128,7 +131,7 @@ bool JournalWriter::append(const control::JournalRecord& r) {
     event.u64(r.cycle);
     event.u8(static_cast<std::uint8_t>(r.safe_reason));
     add_record(RecordType::SafeState, event.data(), static_cast<std::uint32_t>(event.size()));
-    return sync_locked();  // the event and everything before it are on the disk before anything else
+    return sync_locked(lock);  // the event and everything before it are on the disk before anything else
   }
   if (r.safe_reason == control::SafeReason::None) {
     in_safe_state_ = false;  // reset: the next safe state is a new event
@@ -137,7 +140,7 @@ bool JournalWriter::append(const control::JournalRecord& r) {
 }
 
 bool JournalWriter::append_end(std::uint64_t cycles, control::SafeReason reason) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -145,7 +148,7 @@ bool JournalWriter::append_end(std::uint64_t cycles, control::SafeReason reason)
   payload.u64(cycles);
   payload.u8(static_cast<std::uint8_t>(reason));
   add_record(RecordType::End, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync_locked();
+  return sync_locked(lock);
 }
 
 bool JournalWriter::write_out() {
@@ -166,26 +169,33 @@ bool JournalWriter::write_out() {
 }
 
 bool JournalWriter::sync() {
-  const std::lock_guard<std::mutex> lock(mutex_);
-  return sync_locked();
+  std::unique_lock<std::mutex> lock(mutex_);
+  return sync_locked(lock);
 }
 
-bool JournalWriter::sync_locked() {
+// Writes out under the lock, then fsyncs without it: the machine thread must not wait on the disk
+// to record its next command (fd_ stays open until close(), after both threads are done).
+bool JournalWriter::sync_locked(std::unique_lock<std::mutex>& lock) {
   if (fd_ < 0 || failed_) {
     return false;
   }
   if (!write_out()) {
     return false;
   }
-  if (::fsync(fd_) != 0) {
-    return fail("fsync failed", errno);
+  const int fd = fd_;
+  lock.unlock();
+  const int synced = ::fsync(fd);
+  const int error_number = errno;
+  lock.lock();
+  if (synced != 0) {
+    return fail("fsync failed", error_number);
   }
   ++syncs_;
   return true;
 }
 
 bool JournalWriter::sync_if_due(std::int64_t now_ns) {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
@@ -194,15 +204,15 @@ bool JournalWriter::sync_if_due(std::int64_t now_ns) {
   }
   synced_once_ = true;
   last_sync_ns_ = now_ns;
-  return sync_locked();
+  return sync_locked(lock);
 }
 
 bool JournalWriter::close() {
-  const std::lock_guard<std::mutex> lock(mutex_);
+  std::unique_lock<std::mutex> lock(mutex_);
   if (fd_ < 0) {
     return !failed_;
   }
-  const bool synced = failed_ ? false : sync_locked();
+  const bool synced = failed_ ? false : sync_locked(lock);
   const bool closed = ::close(fd_) == 0;
   fd_ = -1;
   if (!closed && synced) {

@@ -78,7 +78,7 @@ class JournalWriter {
   [[nodiscard]] std::uint64_t bytes_written() const { return bytes_written_; }
 
  private:
-  [[nodiscard]] bool sync_locked();
+  [[nodiscard]] bool sync_locked(std::unique_lock<std::mutex>& lock);
   void add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length);
   [[nodiscard]] bool write_out();
   [[nodiscard]] bool fail(const std::string& what, int error_number);
