@@ -310,6 +310,9 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
   if (machine.fault() != hal::MachineFault::None || machine.state() == control::MachineSideState::Stopped) {
     result.machine_error = link.last_error();
   }
+  if (machine.stalled()) {
+    result.machine_error = "the mill found no legal way along the virtual tool's path for 3 s (stalled)";
+  }
   const stencil::sim::StockZmap& stock = machined.stock();
   result.columns = stock.columns();
   result.rows = stock.rows();

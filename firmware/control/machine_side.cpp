@@ -74,6 +74,9 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   const auto completed = static_cast<int>(std::min<std::uint64_t>(moves_done - moves_seen_, 8));
   moves_seen_ = moves_done;
   const motion::PlanResult plan = planner_.plan(completed);
+  if (plan.status != motion::PlanStatus::Blocked) {
+    blocked_in_a_row_ = 0;
+  }
   statistics_.max_lag_mm = std::max(statistics_.max_lag_mm, plan.lag_mm);
   at_goal_ = plan.status == motion::PlanStatus::AtGoal;
   switch (plan.status) {
@@ -117,6 +120,12 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     }
     case motion::PlanStatus::Blocked:
       ++statistics_.blocked;
+      // No legal way for the mill along the tool's path for this long: a fault, not a silent stall
+      // (with the backlog holding the virtual tool, nothing would ever move again).
+      if (++blocked_in_a_row_ > kMaxBlockedUpdates) {
+        stalled_ = true;
+        stop(update_deadline_ns, true);
+      }
       break;
     case motion::PlanStatus::Fault:
     case motion::PlanStatus::NotHomed:

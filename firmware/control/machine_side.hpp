@@ -67,6 +67,9 @@ class MachineSide {
   void record_to(MachineRecorder* recorder) { recorder_ = recorder; }
   // The recorder refused a record: the machine did not start, or was stopped and the cycle told.
   [[nodiscard]] bool record_failed() const { return record_failed_; }
+  // More updates than this in a row with no legal staircase (3 s at 30 Hz) is a fault: stalled().
+  static constexpr int kMaxBlockedUpdates = 90;
+  [[nodiscard]] bool stalled() const { return stalled_; }
   // Where the last target sent puts the tool tip (world mm): home until the first.
   [[nodiscard]] const Eigen::Vector3d& commanded_tip_mm() const { return commanded_tip_mm_; }
 
@@ -85,6 +88,8 @@ class MachineSide {
   CommandedStock* stock_ = nullptr;
   MachineRecorder* recorder_ = nullptr;
   bool record_failed_ = false;
+  int blocked_in_a_row_ = 0;
+  bool stalled_ = false;
   Eigen::Vector3d commanded_tip_mm_;
 };
 
