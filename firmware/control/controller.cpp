@@ -27,6 +27,38 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
   ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
   tool_.limit_speed(config.max_axis_move_mm, config.max_total_move_mm);
   last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
+  board_force_limit_n_ = config.haptic.max_force_n;
+  board_axis_move_mm_ = config.max_axis_move_mm;
+  board_total_move_mm_ = config.max_total_move_mm;
+}
+
+ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
+  if (!std::isfinite(value) || value <= 0.0) {
+    return ParameterOutcome::Refused;
+  }
+  switch (kind) {
+    case CommandKind::SetCoupling: {
+      const double applied =
+          std::clamp(value, config_.min_coupling_n_per_device_mm, config_.max_coupling_n_per_device_mm);
+      config_.haptic.coupling_n_per_device_mm = applied;
+      return applied == value ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetForceLimit: {
+      // Whatever it is sent, never above the board's limit.
+      config_.haptic.max_force_n = std::min(value, board_force_limit_n_);
+      return value <= board_force_limit_n_ ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetSpeedLimit: {
+      const double per_step_mm = value * config_.period_s;
+      config_.max_axis_move_mm = std::min(per_step_mm, board_axis_move_mm_);
+      config_.max_total_move_mm = std::min(per_step_mm, board_total_move_mm_);
+      tool_.limit_speed(config_.max_axis_move_mm, config_.max_total_move_mm);
+      return per_step_mm <= board_axis_move_mm_ && per_step_mm <= board_total_move_mm_ ? ParameterOutcome::Applied
+                                                                                        : ParameterOutcome::Clamped;
+    }
+    default:
+      return ParameterOutcome::Refused;
+  }
 }
 
 void Controller::write_zero_force() {
@@ -87,6 +119,13 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       case CommandKind::Reset:
         last_reset_ = try_reset(now_ns);
         ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
+        break;
+      case CommandKind::SetCoupling:
+      case CommandKind::SetForceLimit:
+      case CommandKind::SetSpeedLimit:
+        last_parameter_ = command.kind;
+        last_parameter_outcome_ = set_parameter(command.kind, command.value);
+        ++parameter_requests_;
         break;
     }
   }
@@ -296,6 +335,16 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   telemetry.safe_reason = safe_reason_;
   telemetry.reset_requests = static_cast<std::uint32_t>(counters_.resets_accepted + counters_.resets_refused);
   telemetry.last_reset = last_reset_;
+  telemetry.device_still_s = static_cast<double>(now_ns - still_since_ns_) / kNsPerS;
+  telemetry.device_to_tool_mm = (device - motion::world_to_device(config_.frames, tool_.tip_mm())).norm();
+  telemetry.wakeup_ns = now_ns - deadline_ns;
+  telemetry.last_compute_ns = last_compute_ns_;
+  telemetry.coupling_n_per_device_mm = config_.haptic.coupling_n_per_device_mm;
+  telemetry.force_limit_n = config_.haptic.max_force_n;
+  telemetry.speed_limit_mm_per_s = config_.max_axis_move_mm / config_.period_s;
+  telemetry.parameter_requests = parameter_requests_;
+  telemetry.last_parameter = last_parameter_;
+  telemetry.last_parameter_outcome = last_parameter_outcome_;
   if (!rings_.telemetry.push(telemetry)) {
     ++counters_.telemetry_dropped;
   }
@@ -304,6 +353,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
 
 void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns) {
   statistics_.compute.add(end_ns - step_start_ns_);
+  last_compute_ns_ = end_ns - step_start_ns_;
   next_deadline_ns_ = next_deadline_ns;
   ++statistics_.cycles;
   if (!config_.count_overruns) {

@@ -42,6 +42,11 @@ struct ControllerConfig {
   double still_time_s = 0.5;              // ... for this long ...
   double reset_distance_mm = 5.0;         // ... and this near the virtual tool (device mm)
   double ramp_time_s = 0.5;               // force comes back over this long after a reset
+  double period_s = 1e-3;                 // the cycle's period: a speed limit in mm/s is this much per step
+  // The operator may set the coupling within [min, max] (N per device mm); the force limit and the
+  // speed limit only ever below the board's (haptic.max_force_n and the move limits above).
+  double min_coupling_n_per_device_mm = 0.05;
+  double max_coupling_n_per_device_mm = 2.0;
 };
 
 enum class CycleStatus : std::uint8_t {
@@ -104,6 +109,7 @@ class Controller {
   void write_zero_force();
   void handle_commands(hal::MonotonicNs now_ns);
   [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);
+  [[nodiscard]] ParameterOutcome set_parameter(CommandKind kind, double value);
   // Reads the device and checks the sample; false when the cycle must not render force.
   [[nodiscard]] bool read_device(hal::MonotonicNs now_ns);
 
@@ -134,6 +140,14 @@ class Controller {
   hal::MonotonicNs step_start_ns_ = 0;
   hal::MonotonicNs step_deadline_ns_ = 0;
   hal::MonotonicNs next_deadline_ns_ = 0;  // from the last finish(): when the next step was due
+  hal::MonotonicNs last_compute_ns_ = 0;   // the last finish()'s step time
+  // The board's limits, from the config at start-up: what the operator's parameters never exceed.
+  double board_force_limit_n_ = 0.0;
+  double board_axis_move_mm_ = 0.0;
+  double board_total_move_mm_ = 0.0;
+  std::uint32_t parameter_requests_ = 0;
+  CommandKind last_parameter_ = CommandKind::SetCoupling;
+  ParameterOutcome last_parameter_outcome_ = ParameterOutcome::None;
   hal::HapticCommand last_command_{};
   double max_force_n_ = 0.0;
   double max_offset_mm_ = 0.0;

@@ -15,11 +15,39 @@ enum class CommandKind : std::uint8_t {
   Reset,  // leave the safe state (accepted only while the device is held still near the virtual tool)
   Stop,   // enter it (SIGINT/SIGTERM, the terminal, the display)
   JournalFailed,  // enter it: the journal writer could not write the record (the cut must stop)
+  // The operator's parameters (the display), taken at the cycle's boundary; `value` in the unit named.
+  // The cycle clamps each to the board's own limit whatever it is sent (see ParameterOutcome).
+  SetCoupling,    // N per device mm: the pull of the device towards the virtual tool
+  SetForceLimit,  // N: never above the board's limit (ControllerConfig::haptic at start-up)
+  SetSpeedLimit,  // world mm/s of the virtual tool: never above the mill's (the config's move limits)
 };
 
 struct Command {
   CommandKind kind;
+  double value = 0.0;  // the Set* commands' new value
 };
+
+// What the cycle made of the newest Set* command.
+enum class ParameterOutcome : std::uint8_t {
+  None,     // none taken yet
+  Applied,  // as asked
+  Clamped,  // above the board's limit (or below the least): the limit applies instead
+  Refused,  // not a finite positive number: nothing changed
+};
+
+[[nodiscard]] constexpr const char* parameter_outcome_name(ParameterOutcome outcome) {
+  switch (outcome) {
+    case ParameterOutcome::None:
+      return "none";
+    case ParameterOutcome::Applied:
+      return "applied";
+    case ParameterOutcome::Clamped:
+      return "clamped";
+    case ParameterOutcome::Refused:
+      return "refused";
+  }
+  return "unknown";
+}
 
 // Why a reset was refused, or that it was taken.
 enum class ResetOutcome : std::uint8_t {
@@ -82,6 +110,20 @@ struct Telemetry {
   SafeReason safe_reason;
   std::uint32_t reset_requests;  // reset commands taken so far (accepted or refused)
   ResetOutcome last_reset;       // what the newest of them came to
+  // For a reset control: how long the device has been held still, and how far it is from the
+  // virtual tool (device mm); the cycle's own reset rule decides, these let a display say why not.
+  double device_still_s;
+  double device_to_tool_mm;
+  // The loop's health: this cycle's wake-up latency and the previous cycle's compute time.
+  std::int64_t wakeup_ns;
+  std::int64_t last_compute_ns;
+  // The parameters in force, and what the newest Set* command came to.
+  double coupling_n_per_device_mm;
+  double force_limit_n;
+  double speed_limit_mm_per_s;   // infinity: unlimited
+  std::uint32_t parameter_requests;
+  CommandKind last_parameter;
+  ParameterOutcome last_parameter_outcome;
 };
 
 // Everything a replay needs and nothing is allowed to lose: the journal ring being full is a fault.

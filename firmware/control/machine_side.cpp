@@ -78,6 +78,7 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     blocked_in_a_row_ = 0;
   }
   statistics_.max_lag_mm = std::max(statistics_.max_lag_mm, plan.lag_mm);
+  statistics_.last_lag_mm = plan.lag_mm;
   at_goal_ = plan.status == motion::PlanStatus::AtGoal;
   switch (plan.status) {
     case motion::PlanStatus::Moved:

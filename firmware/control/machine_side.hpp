@@ -26,6 +26,7 @@ struct MachineSideStatistics {
   std::uint64_t take_ups = 0;     // of which only took up backlash
   std::uint64_t blocked = 0;      // updates with no legal staircase (held)
   double max_lag_mm = 0.0;        // virtual tool to the mill's target, world
+  double last_lag_mm = 0.0;       // the same at the newest update
   std::int64_t motor_steps = 0;   // all axes, take-up included
 };
 

@@ -26,8 +26,19 @@ class TriangleSet {
     if ((word & bit) == 0) {
       word |= bit;
       ++count_;
+      if (observer_ != nullptr) {
+        observer_(observer_context_, id);
+      }
     }
     return true;
+  }
+
+  // Who hears of each id added anew (a display's mirror of the set, for its deltas); nobody by
+  // default. The observer runs inside insert(), so on the cycle's set it must be real-time safe.
+  using Observer = void (*)(void* context, std::uint32_t id);
+  void observe(Observer observer, void* context) {
+    observer_ = observer;
+    observer_context_ = context;
   }
 
   [[nodiscard]] bool contains(std::uint32_t id) const {
@@ -47,6 +58,8 @@ class TriangleSet {
   std::array<std::uint64_t, kCapacity / 64> words_{};
   std::size_t count_ = 0;
   std::size_t refused_ = 0;
+  Observer observer_ = nullptr;
+  void* observer_context_ = nullptr;
 };
 
 }  // namespace stencil::engine
