@@ -33,14 +33,8 @@ motion::MachineFrames rig_frames(const WorkOffset& offset) {
   return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, {-1, -1, -1}, kRig.steps_per_mm};
 }
 
-RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
-  RigResult result;
-  const tables::PartTables& part = *job.part;
+control::ControllerConfig rig_controller_config(const RigJob& job) {
   const motion::MachineFrames frames = rig_frames(job.offset);
-
-  auto rings = std::make_unique<control::CycleRingStorage>();
-  journal::JournalDrain records{job.journal, rings->commands};
-
   control::ControllerConfig config;
   config.frames = frames;
   config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
@@ -52,6 +46,20 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   config.stale_periods = job.stale_periods;
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
   config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  return config;
+}
+
+RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
+  RigResult result;
+  const tables::PartTables& part = *job.part;
+  const motion::MachineFrames frames = rig_frames(job.offset);
+
+  auto rings = std::make_unique<control::CycleRingStorage>();
+  journal::JournalDrain records{job.journal, rings->commands};
+  records.show_on(job.display);
+  control::DisplayCommands display_commands;
+
+  const control::ControllerConfig config = rig_controller_config(job);
   auto controller = std::make_unique<control::Controller>(
       part, *job.device, rings->rings(), config);
   if (!controller->ready()) {
@@ -87,6 +95,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
       result.error = "--resume: " + history_error;
       return result;
     }
+    if (job.display != nullptr) {
+      job.display->seed_touched(controller->touched());  // before the cycle runs: no race
+    }
     result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
   }
   hal::Clock& clock = *job.machine_clock;
@@ -106,6 +117,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
     while (!stop.load()) {
       clock.sleep_until_ns(next);
       machine->update(next + 2 * kUpdateNs);
+      if (job.display != nullptr && model.ready()) {
+        job.display->on_machine(machine->statistics().last_lag_mm, model);
+      }
       next = std::max(next + kUpdateNs, clock.now_ns());
     }
   });
@@ -118,6 +132,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
       records.sync_if_due();
       control::Telemetry frame{};
       while (rings->telemetry.pop(frame)) {
+        if (job.display != nullptr) {
+          job.display->on_telemetry(frame);
+        }
         if (job.progress && frame.safe_reason != last.safe_reason) {
           job.progress(frame.safe_reason == control::SafeReason::None
                            ? std::string("force restored; the mill stays stopped (re-homing to resume the cut is not built yet)")
@@ -129,6 +146,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
           job.progress(std::string("reset refused: ") + control::reset_outcome_name(frame.last_reset));
         }
         last = frame;
+      }
+      if (!stop_sent) {
+        display_commands.forward(job.display, rings->commands);
       }
       if (!stop_sent && job.reset_requested && job.reset_requested()) {
         static_cast<void>(rings->commands.push({control::CommandKind::Reset}));

@@ -12,6 +12,8 @@
 #include <Eigen/Core>
 
 #include "firmware/control/commanded_stock.hpp"
+#include "firmware/control/controller.hpp"
+#include "firmware/control/display_feed.hpp"
 #include "firmware/control/safe_state.hpp"
 #include "firmware/journal/job_history.hpp"
 #include "firmware/journal/journal_writer.hpp"
@@ -63,6 +65,9 @@ struct RigJob {
   std::function<void(const std::string&)> progress;  // a line about every second, and every event
   // Polled by the records thread: true when the operator asks for a reset (typed at the terminal).
   std::function<bool()> reset_requested;
+  // An operator display (--hmi): fed by the records and machine threads, never the cycle; its
+  // requests (parameters, reset) go into the command ring from the records thread.
+  control::DisplayFeed* display = nullptr;
 };
 
 struct RigResult {
@@ -90,6 +95,9 @@ struct RigResult {
 // safe state (zero force, the mill held and stopped) keeps the cycle running until a reset restores
 // the force (the mill stays stopped: carrying on means a new run with --resume, which homes again)
 // or the run is stopped. Blocks.
+// The cycle's configuration for this job (frames, reach, speed limit, watchdogs), as run_rig uses it.
+[[nodiscard]] control::ControllerConfig rig_controller_config(const RigJob& job);
+
 [[nodiscard]] RigResult run_rig(const RigJob& job, const PeriodicRunner& runner);
 
 }  // namespace stencil::board::sherline_suzuki

@@ -220,6 +220,19 @@ stencil::sim::StockBox default_stock(const tables::PartTables& part) {
           (high + margin + Eigen::Vector3d(0, 0, 1.0)).cwiseMin(workspace)};
 }
 
+control::ControllerConfig controller_config(bool realtime) {
+  const motion::MachineFrames frames = sim::frames();
+  control::ControllerConfig config;
+  config.frames = frames;
+  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
+  config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
+  config.home_tip_mm = frames.home_world_mm;
+  config.count_overruns = realtime;  // on virtual time lateness means nothing
+  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  return config;
+}
+
 std::function<double(double, double)> touch_tip_of(const tables::PartTables& part, const stencil::sim::StockBox& stock) {
   auto grid = std::make_shared<stencil::sim::StockZmap>(stock, 0.05);
   auto tips = std::make_shared<std::vector<double>>(
@@ -374,6 +387,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
 
   auto rings = std::make_unique<control::CycleRingStorage>();
   journal::JournalDrain records{job.journal, rings->commands};
+  records.show_on(job.display);
+  control::DisplayCommands display_commands;
   // The operator's hand, where the script starts, and the device it holds.
   stencil::sim::OperatorHand hand;
   hand.handle_mm = job.script.position_at(0.0);
@@ -397,14 +412,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     }
   }
 
-  control::ControllerConfig config;
-  config.frames = frames;
-  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
-  config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
-  config.home_tip_mm = frames.home_world_mm;
-  config.count_overruns = realtime;  // on virtual time lateness means nothing
-  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
-  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  const control::ControllerConfig config = controller_config(realtime);
   // A replay's cycle reads the journal's device; any other's the simulated one.
   stencil::sim::ReplayHapticDevice replay_device;
   hal::HapticDevice& cycle_device = job.replay != nullptr ? static_cast<hal::HapticDevice&>(replay_device) : device.host();
@@ -440,6 +448,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       return result;
     }
     result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
+  }
+  if (job.display != nullptr) {
+    job.display->seed_touched(controller->touched());  // before the cycle runs: no race
   }
   // In real time the fake CY545 answers from a thread of its own; on virtual time it follows the
   // machine side's clock.
@@ -481,6 +492,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
         machine_clock.sleep_until_ns(next);
         machine->update(next + 2 * kUpdateNs);
         fake_runner->with_fake([&](stencil::sim::cy545::FakeCy545&) { machined.flush(); });
+        if (job.display != nullptr) {
+          job.display->on_machine(machine->statistics().last_lag_mm, model);
+        }
         drained.store(machine->path_left() <= 1 && machine->at_goal());
         next = std::max(next + kUpdateNs, machine_clock.now_ns());
       }
@@ -491,7 +505,11 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
         records.sync_if_due();
         control::Telemetry frame{};
         while (rings->telemetry.pop(frame)) {
+          if (job.display != nullptr) {
+            job.display->on_telemetry(frame);
+          }
         }
+        display_commands.forward(job.display, rings->commands);
         if (job.interrupted != nullptr && job.interrupted->load()) {
           static_cast<void>(rings->commands.push({control::CommandKind::Stop}));
         }
@@ -560,6 +578,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       machine_clock.sleep_until_ns(cycle_ns);
       machine->update(machine_clock.now_ns() + 2 * kUpdateNs);
       machined.flush();
+      if (job.display != nullptr) {
+        job.display->on_machine(machine->statistics().last_lag_mm, model);
+      }
       if (machine->state() == control::MachineSideState::Stopped && result.machine_stopped_s < 0.0) {
         result.machine_stopped_s = static_cast<double>(cycle_ns - start_ns) / 1e9;
       }
@@ -632,6 +653,12 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     records.drain(rings->journal);
     control::Telemetry frame{};
     while (rings->telemetry.pop(frame)) {
+      if (job.display != nullptr) {
+        job.display->on_telemetry(frame);
+      }
+    }
+    if (job.display != nullptr && controller->statistics().cycles % 20 == 0) {
+      display_commands.forward(job.display, rings->commands);
     }
     cycle_ns += kPeriodNs;
     if (safe) {

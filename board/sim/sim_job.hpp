@@ -13,7 +13,9 @@
 
 #include <Eigen/Core>
 
+#include "firmware/control/controller.hpp"
 #include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/display_feed.hpp"
 #include "firmware/control/safe_state.hpp"
 #include "firmware/journal/job_history.hpp"
 #include "firmware/motion/machine_frames.hpp"
@@ -91,6 +93,9 @@ struct SimJob {
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;
+  // An operator display (--hmi): fed from the records side and the machine side, never the cycle;
+  // its requests go into the command ring.
+  control::DisplayFeed* display = nullptr;
 };
 
 // Runs cycle(now_ns, deadline_ns) once per period (on a real-time thread, where the host allows)
@@ -175,6 +180,10 @@ struct SimResult {
 // part's top over a 0.05 mm grid of the stock (the scripted operator's idea of the part).
 [[nodiscard]] std::function<double(double, double)> touch_tip_of(const tables::PartTables& part,
                                                                   const stencil::sim::StockBox& stock);
+
+// The cycle's configuration in the simulation (frames, reach, the mill's speed; overruns count in
+// real time only).
+[[nodiscard]] control::ControllerConfig controller_config(bool realtime);
 
 // The simulation board's device -> world -> machine frames (above).
 [[nodiscard]] motion::MachineFrames frames();

@@ -24,6 +24,7 @@
 
 #include "board/sherline_suzuki/rig_constants.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
+#include "firmware/app/display_option.hpp"
 #include "firmware/app/realtime_thread.hpp"
 #include "firmware/app/rt_readiness.hpp"
 #include "firmware/journal/job_history.hpp"
@@ -169,6 +170,8 @@ int main(int argc, char** argv) {
   double duration_s = 0.0;
   app.add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
+  app::DisplayOptions display_options;
+  app::add_display_options(app, display_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -339,6 +342,20 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "stencil-rig: the other threads could not be kept off CPU %d\n", cpu);
   }
   board::sherline_suzuki::RigJob job;
+  job.offset = offset;
+  app::Display display;
+  std::string display_error;
+  if (!display.start(display_options, part, board::sherline_suzuki::rig_controller_config(job), display_error)) {
+    // Nothing ran: a fresh journal of nothing goes, a resumed one goes back to the job it held.
+    static_cast<void>(journal_writer.close());
+    if (resume_path.empty() && !journal_path.empty()) {
+      std::remove(journal_path.c_str());
+    } else if (!resume_path.empty() && ::truncate(resume_path.c_str(), static_cast<off_t>(history.good_bytes)) != 0) {
+      std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", resume_path.c_str());
+    }
+    return fail(kExitBadInput, display_error);
+  }
+  job.display = display.feed();
   job.part = &part;
   job.device = device;
   job.machine = &link;
@@ -367,6 +384,7 @@ int main(int argc, char** argv) {
         refused = setup.refused.empty() ? "" : "--require-rt: " + setup.refused;
         return setup.refused.empty();
       });
+  display.stop();
   if (journal_writer.is_open() && result.started) {
     static_cast<void>(journal_writer.append_end(result.cycles, result.safe_state));  // an orderly end, not a kill
   }

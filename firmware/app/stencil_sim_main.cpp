@@ -21,6 +21,7 @@
 
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
+#include "firmware/app/display_option.hpp"
 #include "firmware/app/realtime_thread.hpp"
 #include "firmware/journal/journal_reader.hpp"
 #include "firmware/tables/table_loader.hpp"
@@ -253,6 +254,8 @@ int main(int argc, char** argv) {
                  "SocketCAN code over a memfd or a socketpair")
       ->check(CLI::IsMember({"direct", "pio", "can"}))
       ->capture_default_str();
+  app::DisplayOptions display_options;
+  app::add_display_options(app, display_options);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -281,9 +284,9 @@ int main(int argc, char** argv) {
   }
   if (!replay_path.empty()) {
     if (!resume_path.empty() || !journal_path.empty() || !inject_text.empty() || app.count("--device-process") > 0 ||
-        speed == 1.0) {
+        speed == 1.0 || display_options.requested()) {
       return bad_input("--replay runs the recorded job on the virtual clock by itself: no --resume, --journal, --inject, "
-                       "--device-process or --speed 1 with it");
+                       "--device-process, --hmi or --speed 1 with it");
     }
     fast = fast || speed == 0.0;
     no_journal = true;
@@ -477,6 +480,12 @@ int main(int argc, char** argv) {
     std::printf("journal: %s\n", journal_path.c_str());
     std::fflush(stdout);
   }
+  // The display, before the job: a page opened now sees the job from its start.
+  app::Display display;
+  if (!display.start(display_options, part, board::sim::controller_config(!fast && speed == 1.0), error)) {
+    return bad_input(error);
+  }
+  job.display = display.feed();
   job.interrupted = &interrupted;
   board::sim::SimResult result;
   if (fast || speed != 1.0) {
@@ -505,6 +514,7 @@ int main(int argc, char** argv) {
   if (job.progress) {
     std::fprintf(stderr, "\n");
   }
+  display.stop();
   if (trace != nullptr) {
     std::fclose(trace);
   }

@@ -1,6 +1,8 @@
 #include "firmware/hmi/hmi_server.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -68,9 +70,18 @@ struct HmiServer::Client {
   std::once_flag joined;
 };
 
+HmiLimits limits_of(const control::ControllerConfig& config) {
+  HmiLimits limits;
+  limits.board_force_limit_n = config.haptic.max_force_n;
+  limits.mill_speed_mm_per_s = std::min(config.max_axis_move_mm, config.max_total_move_mm) / config.period_s;
+  limits.min_coupling_n_per_device_mm = config.min_coupling_n_per_device_mm;
+  limits.max_coupling_n_per_device_mm = config.max_coupling_n_per_device_mm;
+  return limits;
+}
+
 HmiServer::HmiServer(const HmiServerOptions& options, const tables::PartTables& part,
-                     const control::ControllerConfig& config, const HmiLimits& limits)
-    : options_(options), limits_(limits), state_(part, config, limits) {}
+                     const control::ControllerConfig& config)
+    : options_(options), limits_(limits_of(config)), state_(part, config, limits_) {}
 
 HmiServer::~HmiServer() { stop(); }
 

@@ -24,6 +24,7 @@
 #include "firmware/control/commanded_stock.hpp"
 #include "firmware/control/controller.hpp"
 #include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/display_feed.hpp"
 #include "firmware/hmi/hmi_access.hpp"
 #include "firmware/hmi/hmi_live_state.hpp"
 #include "firmware/hmi/hmi_requests.hpp"
@@ -57,11 +58,14 @@ struct HmiServerStats {
   std::uint32_t clients = 0;           // connected now
 };
 
-class HmiServer {
+[[nodiscard]] HmiLimits limits_of(const control::ControllerConfig& config);
+
+class HmiServer final : public control::DisplayFeed {
  public:
-  HmiServer(const HmiServerOptions& options, const tables::PartTables& part, const control::ControllerConfig& config,
-            const HmiLimits& limits);
-  ~HmiServer();
+  // The limits a request is checked against come from the cycle's own config (its force limit is
+  // the board's; its move limits the mill's speed).
+  HmiServer(const HmiServerOptions& options, const tables::PartTables& part, const control::ControllerConfig& config);
+  virtual ~HmiServer();
   HmiServer(const HmiServer&) = delete;
   HmiServer& operator=(const HmiServer&) = delete;
 
@@ -73,15 +77,15 @@ class HmiServer {
   [[nodiscard]] std::string url() const;
 
   // From the board's records thread (or the fast loop): every journal record, every telemetry.
-  void on_record(const control::JournalRecord& record);
-  void on_telemetry(const control::Telemetry& telemetry);
+  void on_record(const control::JournalRecord& record) override;
+  void on_telemetry(const control::Telemetry& telemetry) override;
   // From the thread that owns the machine side, after an update: at most 10 times a second it
   // samples the stock model (on the calling thread, outside the lock).
-  void on_machine(double lag_mm, const control::CommandedStock& model);
+  void on_machine(double lag_mm, const control::CommandedStock& model) override;
   // Before the cycle starts: a resumed job's touched set.
-  void seed_touched(const engine::TriangleSet& touched);
+  void seed_touched(const engine::TriangleSet& touched) override;
   // The operator's accepted requests, for the command ring, oldest first (at most 16 wait).
-  [[nodiscard]] bool pop_command(control::Command& command);
+  [[nodiscard]] bool pop_command(control::Command& command) override;
 
   [[nodiscard]] HmiServerStats stats() const;
 

@@ -7,6 +7,7 @@
 #include <chrono>
 
 #include "firmware/control/cycle_messages.hpp"
+#include "firmware/control/display_feed.hpp"
 #include "firmware/journal/journal_writer.hpp"
 
 namespace stencil::journal {
@@ -18,6 +19,9 @@ class JournalDrain {
   void drain(control::JournalRing& ring) {
     control::JournalRecord record{};
     while (ring.pop(record)) {
+      if (display_ != nullptr) {
+        display_->on_record(record);
+      }
       if (writer_ != nullptr && !failed_ && !writer_->append(record)) {
         failed_ = true;
       }
@@ -36,6 +40,9 @@ class JournalDrain {
 
   [[nodiscard]] bool failed() const { return failed_; }
 
+  // An operator display also sees every record drained (none by default).
+  void show_on(control::DisplayFeed* display) { display_ = display; }
+
  private:
   // Until the cycle has the news: a full command ring is tried again at the next look.
   void tell_the_cycle() {
@@ -46,6 +53,7 @@ class JournalDrain {
 
   JournalWriter* writer_;
   control::CommandRing& commands_;
+  control::DisplayFeed* display_ = nullptr;
   bool failed_ = false;
   bool told_ = false;
 };
