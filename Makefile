@@ -1,11 +1,12 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test test-asan test-debug rt fuzz bench demo latency soak soak-asan clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak soak-asan clean help
 
 all: build
 
 help:
 	@echo "make demo       install dependencies, build, and run the host simulation on the baked-in hex prism (raster job)"
 	@echo "make test       install dependencies, configure, build and run every test (release preset)"
+	@echo "make e2e        the end-to-end tests only, the operator display in headless Chromium among them"
 	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
 	@echo "make test-debug the same without optimisation (build/debug)"
 	@echo "make build      build only (binaries in build/bin)"
@@ -26,6 +27,10 @@ build: deps
 
 test: build
 	ctest --preset release
+
+# The end-to-end tests only (the programs, the fault suite, the operator display in headless Chromium).
+e2e: build
+	ctest --preset release -L e2e
 
 bench: build
 	build/bin/stencil-bench

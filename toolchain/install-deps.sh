@@ -36,7 +36,15 @@ packages=(
   libfcl-dev         # stencil-bench compares the engine with the Flexible Collision Library
   clang              # the fuzz preset's compiler (libFuzzer needs clang)
   libclang-rt-14-dev # libFuzzer and the sanitizer runtimes for clang 14 (only recommended by clang)
+  libcivetweb-dev    # the operator display's HTTP + WebSocket server (--hmi)
+  chromium           # the display's end-to-end test, headless (driven by playwright-core from npm)
+  fonts-dejavu-core  # text in that browser's screenshots
 )
+# The display's page is built with npm (three.js and esbuild, pinned by its package-lock.json): the
+# machine's own Node.js and npm when it has them, else Debian's.
+if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
+  packages+=(nodejs npm)
+fi
 if [ "$cross" -eq 1 ]; then
   packages+=(g++-aarch64-linux-gnu zlib1g-dev:arm64)
 fi
