@@ -24,8 +24,8 @@
 
 namespace stencil::hmi {
 
-// The stock as machined, coarse enough to send: the lowest height of the model's cells under each
-// display cell, row-major from the block's low corner.
+// The stock as machined, coarse enough to send: the lowest height of the model's cells sampled
+// under each display cell, row-major from the block's low corner.
 struct StockGrid {
   double x0_mm = 0.0, y0_mm = 0.0, cell_mm = 0.0;
   int columns = 0, rows = 0;

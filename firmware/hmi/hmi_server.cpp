@@ -211,9 +211,12 @@ void HmiServer::on_machine(double lag_mm, const control::CommandedStock& model) 
     return;
   }
   last_machine_ns_ = now_ns;
-  StockGrid grid = coarse_stock(model);  // on the caller's thread, which owns the model
+  on_stock(lag_mm, coarse_stock(model));  // sampled on the caller's thread, which owns the model
+}
+
+void HmiServer::on_stock(double lag_mm, StockGrid stock) {
   const std::lock_guard<std::mutex> lock(state_mutex_);
-  state_.on_machine(lag_mm, std::move(grid));
+  state_.on_machine(lag_mm, std::move(stock));
 }
 
 void HmiServer::seed_touched(const engine::TriangleSet& touched) {
@@ -485,15 +488,18 @@ void HmiServer::frame_loop() {
       want_snapshot = want_snapshot || client->need_snapshot || !client->pending.empty();
     }
     const nlohmann::json server = server_json();
-    std::string frame, snapshot;
+    nlohmann::json frame_json, snapshot_json;
     {
       const std::lock_guard<std::mutex> lock(state_mutex_);
       ++sequence_;
-      frame = state_.frame(sequence_, server).dump();
+      frame_json = state_.frame(sequence_, server);
       if (want_snapshot) {
-        snapshot = state_.snapshot(sequence_, server).dump();
+        snapshot_json = state_.snapshot(sequence_, server);
       }
     }
+    // Serialised outside the lock: the feeding threads wait only for the state's copy.
+    const std::string frame = frame_json.dump();
+    const std::string snapshot = want_snapshot ? snapshot_json.dump() : std::string();
     std::uint64_t dropped = 0, snapshots = 0;
     for (const auto& client : clients) {
       {

@@ -82,6 +82,8 @@ class HmiServer final : public control::DisplayFeed {
   // From the thread that owns the machine side, after an update: at most 10 times a second it
   // samples the stock model (on the calling thread, outside the lock).
   void on_machine(double lag_mm, const control::CommandedStock& model) override;
+  // The same with the stock already sampled (on_machine's second half).
+  void on_stock(double lag_mm, StockGrid stock);
   // Before the cycle starts: a resumed job's touched set.
   void seed_touched(const engine::TriangleSet& touched) override;
   // The operator's accepted requests, for the command ring, oldest first (at most 16 wait).

@@ -453,3 +453,67 @@ TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtNinetyPercentHoldsIt) {
   CHECK(bench.controller->safe_reason() == SafeReason::None);  // slowed, not a fault
   DOUBLES_EQUAL(1e-3, moved_in_a_cycle(20), 1e-12);
 }
+
+TEST(Controller, AForceLimitAboveTheBoardsIsClampedToItAndOneBelowItHoldsTheForceThere) {
+  Bench bench;
+  bench.cycles(600);  // past the start's ramp
+  CHECK(bench.commands.push({CommandKind::SetForceLimit, 50.0}));
+  CHECK(bench.cycle() == CycleStatus::Running);
+  DOUBLES_EQUAL(5.0, bench.last_telemetry.force_limit_n, 0.0);
+  CHECK(bench.last_telemetry.last_parameter == CommandKind::SetForceLimit);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Clamped);
+  // Deep into the prism's top (z = 6): the spring would pull far harder than any limit.
+  bench.move_device_to(Eigen::Vector3d(250.0, 125.0, 30.0), 400.0);
+  bench.cycles(5);
+  DOUBLES_EQUAL(5.0, bench.force_written(), 1e-9);
+  CHECK(bench.commands.push({CommandKind::SetForceLimit, 2.0}));
+  bench.cycles(2);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Applied);
+  DOUBLES_EQUAL(2.0, bench.last_telemetry.force_limit_n, 0.0);
+  DOUBLES_EQUAL(2.0, bench.force_written(), 1e-9);
+  CHECK_EQUAL(2U, bench.last_telemetry.parameter_requests);
+}
+
+TEST(Controller, TheCouplingIsKeptInItsRangeAndANumberThatIsNotOneChangesNothing) {
+  Bench bench;
+  bench.cycles(2);
+  DOUBLES_EQUAL(0.5, bench.last_telemetry.coupling_n_per_device_mm, 0.0);
+  CHECK(bench.commands.push({CommandKind::SetCoupling, 0.8}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Applied);
+  DOUBLES_EQUAL(0.8, bench.last_telemetry.coupling_n_per_device_mm, 0.0);
+  CHECK(bench.commands.push({CommandKind::SetCoupling, 10.0}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Clamped);
+  DOUBLES_EQUAL(2.0, bench.last_telemetry.coupling_n_per_device_mm, 0.0);
+  CHECK(bench.commands.push({CommandKind::SetCoupling, std::numeric_limits<double>::quiet_NaN()}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Refused);
+  DOUBLES_EQUAL(2.0, bench.last_telemetry.coupling_n_per_device_mm, 0.0);
+  CHECK(bench.commands.push({CommandKind::SetForceLimit, -1.0}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Refused);
+  DOUBLES_EQUAL(5.0, bench.last_telemetry.force_limit_n, 0.0);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+}
+
+TEST(Controller, ASpeedLimitNeverRaisesTheMillsAndALowerOneSlowsTheVirtualTool) {
+  ControllerConfig c = config();
+  c.max_axis_move_mm = 1e-3;
+  c.max_total_move_mm = 1e-3;
+  Bench bench(c);
+  bench.cycles(5);
+  DOUBLES_EQUAL(1.0, bench.last_telemetry.speed_limit_mm_per_s, 1e-12);
+  CHECK(bench.commands.push({CommandKind::SetSpeedLimit, 5.0}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Clamped);
+  DOUBLES_EQUAL(1.0, bench.last_telemetry.speed_limit_mm_per_s, 1e-12);
+  CHECK(bench.commands.push({CommandKind::SetSpeedLimit, 0.25}));
+  bench.cycles(1);
+  CHECK(bench.last_telemetry.last_parameter_outcome == ParameterOutcome::Applied);
+  DOUBLES_EQUAL(0.25, bench.last_telemetry.speed_limit_mm_per_s, 1e-12);
+  bench.move_device_to(kHomeDevice - Eigen::Vector3d(100.0, 0.0, 0.0), 500.0);
+  const Eigen::Vector3d before = bench.controller->virtual_tip_mm();
+  CHECK(bench.cycle() == CycleStatus::Running);
+  DOUBLES_EQUAL(0.25e-3, (bench.controller->virtual_tip_mm() - before).cwiseAbs().sum(), 1e-12);
+}
