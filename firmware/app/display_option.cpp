@@ -28,6 +28,27 @@ void add_display_options(CLI::App& app, DisplayOptions& options) {
   app.add_option("--hmi-assets", options.assets_dir, "the built page's folder (default: ../hmi beside the program)");
 }
 
+bool check_display_options(const DisplayOptions& options, std::string& error) {
+  if (!options.requested()) {
+    if (!options.token.empty() || !options.assets_dir.empty()) {
+      error = "--hmi-token and --hmi-assets go with --hmi";
+      return false;
+    }
+    return true;
+  }
+#ifdef STENCIL_HAVE_HMI
+  hmi::HmiEndpoint endpoint;
+  if (!hmi::parse_endpoint(options.endpoint, endpoint, error)) {
+    error = "--hmi " + error;
+    return false;
+  }
+  return hmi::check_access(endpoint, options.token, error);
+#else
+  error = "--hmi: this program was built without the display's server (civetweb: install libcivetweb-dev and rebuild)";
+  return false;
+#endif
+}
+
 #ifdef STENCIL_HAVE_HMI
 Display::Display() = default;
 Display::~Display() { stop(); }

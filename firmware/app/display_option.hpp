@@ -27,6 +27,10 @@ struct DisplayOptions {
 
 void add_display_options(CLI::App& app, DisplayOptions& options);
 
+// Right after parsing, before anything is opened: a bad endpoint or token (or --hmi-token without
+// --hmi) is bad input. False with the reason.
+[[nodiscard]] bool check_display_options(const DisplayOptions& options, std::string& error);
+
 // The display's server while a job runs. start() does nothing when --hmi was not given.
 class Display {
  public:

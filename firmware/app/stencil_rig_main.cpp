@@ -177,6 +177,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
   }
+  {
+    std::string display_error;
+    if (!app::check_display_options(display_options, display_error)) {
+      return fail(kExitBadInput, display_error);
+    }
+  }
+
   // (CLI11's range check lets a NaN through: every comparison with it is false.)
   if (!std::isfinite(stick_out) || !std::isfinite(reference_stick_out)) {
     return fail(kExitBadInput, "--tool-stick-out and --reference-stick-out: expected a length in mm from 0 to 100");

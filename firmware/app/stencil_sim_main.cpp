@@ -261,6 +261,13 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
   }
+  {
+    std::string display_error;
+    if (!app::check_display_options(display_options, display_error)) {
+      return bad_input(display_error);
+    }
+  }
+
   if ((fast || (speed > 0.0 && speed != 1.0)) &&
       (app.count("--priority") + app.count("--cpu") + app.count("--require-rt")) > 0) {
     return bad_input("--priority, --cpu and --require-rt are for the real-time threads of --speed 1 only");

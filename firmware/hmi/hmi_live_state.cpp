@@ -258,9 +258,9 @@ nlohmann::json LiveState::part_mesh() const {
   nlohmann::json reachable = nlohmann::json::array();
   for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
     for (const tables::PackedPoint& v : part_.triangles[t].vertices) {
-      vertices.push_back(rounded(v.x_mm, 1e-4));
-      vertices.push_back(rounded(v.y_mm, 1e-4));
-      vertices.push_back(rounded(v.z_mm, 1e-4));
+      vertices.push_back(rounded(static_cast<double>(v.x_mm), 1e-4));
+      vertices.push_back(rounded(static_cast<double>(v.y_mm), 1e-4));
+      vertices.push_back(rounded(static_cast<double>(v.z_mm), 1e-4));
     }
     reachable.push_back((part_.triangle_flags[t] & tables::kTriangleReachable) != 0 ? 1 : 0);
   }

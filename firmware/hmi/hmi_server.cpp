@@ -450,7 +450,8 @@ void HmiServer::send_loop(const std::shared_ptr<Client>& client) {
     // timeout); a client that took nothing for that long is dropped.
     const int written = mg_websocket_write(client->conn, MG_WEBSOCKET_OPCODE_TEXT, message.data(), message.size());
     const std::lock_guard<std::mutex> lock(stats_mutex_);
-    if (written <= 0) {
+    // Short: the write timed out part way, and the client's stream is broken from here.
+    if (written <= 0 || static_cast<std::size_t>(written) < message.size()) {
       ++stats_.clients_dropped;
       const std::lock_guard<std::mutex> client_lock(client->mutex);
       client->closed = true;  // nothing more is sent; civetweb closes it on its side

@@ -466,6 +466,28 @@ case_refuses_a_bad_inject() {
   expect_stderr "--inject: faults are injected on the virtual clock" "where faults can be injected"
 }
 
+case_refuses_a_bad_display_option() {
+  run_sim --fast --pattern raster --duration 1 --hmi 0.0.0.0:8080
+  expect_status 2
+  expect_stderr "--hmi 0.0.0.0: listening beyond this machine needs --hmi-token T" "that a token is needed"
+  run_sim --fast --pattern raster --duration 1 --hmi 127.0.0.1
+  expect_status 2
+  expect_stderr "expected HOST:PORT" "the form expected"
+  run_sim --fast --pattern raster --duration 1 --hmi 0.0.0.0:8080 --hmi-token short
+  expect_status 2
+  expect_stderr "--hmi-token: at least 8 characters" "the token's rule"
+  run_sim --fast --pattern raster --duration 1 --hmi-token s3cret-token
+  expect_status 2
+  expect_stderr "--hmi-token and --hmi-assets go with --hmi" "the option it needs"
+  run_sim --fast --pattern raster --duration 1 --no-journal --hmi 127.0.0.1:0 --hmi-assets "$PWD/no-page"
+  expect_status 2
+  expect_stderr "the display's page is not built: no .*no-page/index.html" "that the page is missing"
+  : >part.stbl
+  run_rig --tables part.stbl --serial /dev/ttyS0 --haptic pio:/dev/uio0 --hmi 0.0.0.0:8080
+  expect_status 2
+  expect_stderr "listening beyond this machine needs --hmi-token" "that a token is needed (the rig, before it opens anything)"
+}
+
 case_refuses_a_bad_operator_csv() {
   printf 't_s,x_mm,y_mm,z_mm\n0,250,125,200\n0.5,250,abc,200\n' >operator.csv
   run_sim --fast --operator operator.csv --report report.json
