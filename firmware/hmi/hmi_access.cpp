@@ -100,4 +100,13 @@ bool may_control(const std::string& token, std::string_view presented) {
   return difference == 0;
 }
 
+bool same_origin(std::string_view origin, std::string_view host) {
+  for (const std::string_view scheme : {std::string_view("http://"), std::string_view("https://")}) {
+    if (origin.substr(0, scheme.size()) == scheme) {
+      return !host.empty() && origin.substr(scheme.size()) == host;
+    }
+  }
+  return false;  // "null" (a file:// page, a sandboxed frame) or anything else
+}
+
 }  // namespace stencil::hmi

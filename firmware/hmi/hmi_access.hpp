@@ -28,4 +28,8 @@ struct HmiEndpoint {
 // in constant time). Everyone else watches.
 [[nodiscard]] bool may_control(const std::string& token, std::string_view presented);
 
+// Whether a WebSocket's Origin header ("http://127.0.0.1:8080") names the server's own Host header
+// ("127.0.0.1:8080"): the page that opened it is this server's, not another site's.
+[[nodiscard]] bool same_origin(std::string_view origin, std::string_view host);
+
 }  // namespace stencil::hmi

@@ -55,6 +55,12 @@ nlohmann::json reply(const char* type, const Request* request, const std::string
   return out;
 }
 
+// Serialised without ever throwing: text from a client (quoted back in an error) may not be valid
+// UTF-8, and an exception must never leave a civetweb callback.
+std::string text_of(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
+}
+
 }  // namespace
 
 struct HmiServer::Client {
@@ -114,7 +120,7 @@ bool HmiServer::start(std::string& error) {
   }
   {
     const std::lock_guard<std::mutex> lock(state_mutex_);
-    part_json_ = state_.part_mesh().dump();
+    part_json_ = text_of(state_.part_mesh());
   }
   const bool v6 = options_.endpoint.host.find(':') != std::string::npos;
   const std::string listening = (v6 ? "[" + options_.endpoint.host + "]" : options_.endpoint.host) + ":" +
@@ -167,7 +173,8 @@ void HmiServer::stop() {
   if (frame_thread_.joinable()) {
     frame_thread_.join();
   }
-  // The senders first (a blocked write ends within the write timeout), then civetweb's workers.
+  // Every sender takes nothing more; then civetweb stops: its stop flag ends any write in progress,
+  // and each connection's close handler joins its sender. Any sender left is joined after.
   std::vector<std::shared_ptr<Client>> clients;
   {
     const std::lock_guard<std::mutex> lock(clients_mutex_);
@@ -179,18 +186,18 @@ void HmiServer::stop() {
       client->closed = true;
     }
     client->wake.notify_all();
+  }
+  mg_stop(context_);
+  context_ = nullptr;
+  for (const auto& client : clients) {
     std::call_once(client->joined, [&] {
       if (client->sender.joinable()) {
         client->sender.join();
       }
     });
   }
-  mg_stop(context_);
-  context_ = nullptr;
-  {
-    const std::lock_guard<std::mutex> lock(clients_mutex_);
-    clients_.clear();
-  }
+  const std::lock_guard<std::mutex> lock(clients_mutex_);
+  clients_.clear();
 }
 
 void HmiServer::on_record(const control::JournalRecord& record) {
@@ -258,7 +265,7 @@ std::string HmiServer::handle_message(bool may_control, std::string_view text) {
   if (!parse_request(text, request, error)) {
     const std::lock_guard<std::mutex> lock(stats_mutex_);
     ++stats_.malformed;
-    return reply("error", nullptr, error).dump();
+    return text_of(reply("error", nullptr, error));
   }
   std::string refused;
   if (!may_control) {
@@ -283,14 +290,21 @@ std::string HmiServer::handle_message(bool may_control, std::string_view text) {
   const std::lock_guard<std::mutex> lock(stats_mutex_);
   if (!refused.empty()) {
     ++stats_.refused;
-    return reply("refused", &request, refused).dump();
+    return text_of(reply("refused", &request, refused));
   }
   ++stats_.accepted;
-  return reply("accepted", &request, "passed to the cycle; its outcome comes in the frames' params").dump();
+  return text_of(reply("accepted", &request, "passed to the cycle; its outcome comes in the frames' params"));
 }
 
 int HmiServer::on_http(mg_connection* conn, void* self_pointer) {
-  auto& self = *static_cast<HmiServer*>(self_pointer);
+  try {
+    return serve_http(conn, *static_cast<HmiServer*>(self_pointer));
+  } catch (...) {
+    return 500;  // civetweb answers it; the server goes on
+  }
+}
+
+int HmiServer::serve_http(mg_connection* conn, HmiServer& self) {
   const mg_request_info* info = mg_get_request_info(conn);
   const std::string method = info->request_method != nullptr ? info->request_method : "";
   const bool head = method == "HEAD";
@@ -311,7 +325,7 @@ int HmiServer::on_http(mg_connection* conn, void* self_pointer) {
       status["touched"] = self.state_.touched_count();
       status["frames"] = self.sequence_;
     }
-    send_response(conn, 200, "OK", "application/json", status.dump(), head);
+    send_response(conn, 200, "OK", "application/json", text_of(status), head);
     return 200;
   }
   if (uri == "/") {
@@ -326,91 +340,102 @@ int HmiServer::on_http(mg_connection* conn, void* self_pointer) {
   return 200;
 }
 
-int HmiServer::on_ws_connect(const mg_connection*, void* self_pointer) {
+int HmiServer::on_ws_connect(const mg_connection* conn, void* self_pointer) {
   auto& self = *static_cast<HmiServer*>(self_pointer);
-  const std::lock_guard<std::mutex> lock(self.clients_mutex_);
-  if (self.stopping_.load() ||
-      static_cast<int>(self.clients_.size()) + self.pending_connections_.load() >= self.options_.max_clients) {
-    const std::lock_guard<std::mutex> stats_lock(self.stats_mutex_);
-    ++self.stats_.connections_refused;
-    return 1;  // refused before the handshake
+  try {
+    // A browser says which page opened the socket: another site's page (open in the operator's
+    // browser) must not reach the controller through it.
+    const char* origin = mg_get_header(conn, "Origin");
+    const char* host = mg_get_header(conn, "Host");
+    const bool foreign = origin != nullptr && !same_origin(origin, host != nullptr ? host : "");
+    // Admission counts connected clients only: a handshake that fails after this is never counted.
+    const std::lock_guard<std::mutex> lock(self.clients_mutex_);
+    if (self.stopping_.load() || foreign || static_cast<int>(self.clients_.size()) >= self.options_.max_clients) {
+      const std::lock_guard<std::mutex> stats_lock(self.stats_mutex_);
+      ++self.stats_.connections_refused;
+      return 1;  // refused before the handshake
+    }
+    return 0;
+  } catch (...) {
+    return 1;
   }
-  ++self.pending_connections_;
-  return 0;
 }
 
 void HmiServer::on_ws_ready(mg_connection* conn, void* self_pointer) {
   auto& self = *static_cast<HmiServer*>(self_pointer);
-  auto client = std::make_shared<Client>();
-  client->conn = conn;
-  const mg_request_info* info = mg_get_request_info(conn);
-  char token[256] = {};
-  const char* query = info->query_string != nullptr ? info->query_string : "";
-  const int length = mg_get_var(query, std::strlen(query), "token", token, sizeof token);
-  client->may_control = may_control(self.options_.token, length > 0 ? std::string_view(token, static_cast<std::size_t>(length)) : std::string_view());
-  nlohmann::json hello{{"type", "hello"}, {"may_control", client->may_control},
-                       {"frame_hz", self.options_.frame_hz}};
-  if (!client->may_control) {
-    hello["reason"] = "watch-only: open the page with ?token=... (--hmi-token) to change anything";
-  }
-  client->replies.push_back(hello.dump());
-  mg_set_user_connection_data(conn, new std::shared_ptr<Client>(client));
-  {
+  try {
+    auto client = std::make_shared<Client>();
+    client->conn = conn;
+    const mg_request_info* info = mg_get_request_info(conn);
+    char token[256] = {};
+    const char* query = info->query_string != nullptr ? info->query_string : "";
+    const int length = mg_get_var(query, std::strlen(query), "token", token, sizeof token);
+    client->may_control = may_control(self.options_.token, length > 0 ? std::string_view(token, static_cast<std::size_t>(length))
+                                                                      : std::string_view());
+    nlohmann::json hello{{"type", "hello"}, {"may_control", client->may_control}, {"frame_hz", self.options_.frame_hz}};
+    if (!client->may_control) {
+      hello["reason"] = "watch-only: open the page with ?token=... (--hmi-token) to change anything";
+    }
+    client->replies.push_back(text_of(hello));
+    // The sender first, then the client made visible: stop() and the close handler only ever see a
+    // client whose sender exists.
+    client->sender = std::thread([&self, client] { self.send_loop(client); });
+    mg_set_user_connection_data(conn, new std::shared_ptr<Client>(client));
     const std::lock_guard<std::mutex> lock(self.clients_mutex_);
-    --self.pending_connections_;
     self.clients_.push_back(client);
+  } catch (...) {
+    // No thread or no memory: this client gets nothing; civetweb closes it when it next reads.
   }
-  client->sender = std::thread([&self, client] { self.send_loop(client); });
 }
 
 int HmiServer::on_ws_data(mg_connection* conn, int bits, char* data, std::size_t length, void* self_pointer) {
   auto& self = *static_cast<HmiServer*>(self_pointer);
-  auto* holder = static_cast<std::shared_ptr<Client>*>(mg_get_user_connection_data(conn));
-  if (holder == nullptr) {
-    return 0;
-  }
-  const std::shared_ptr<Client>& client = *holder;
-  const int opcode = bits & 0x0F;
-  if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) {
-    return 0;
-  }
-  if (opcode == MG_WEBSOCKET_OPCODE_PING || opcode == MG_WEBSOCKET_OPCODE_PONG) {
-    return 1;
-  }
-  std::string answer;
-  bool keep = true;
-  if (opcode != MG_WEBSOCKET_OPCODE_TEXT || (bits & 0x80) == 0) {
-    const std::lock_guard<std::mutex> lock(self.stats_mutex_);
-    ++self.stats_.malformed;
-    answer = reply("error", nullptr, "expected one unfragmented text frame of JSON").dump();
-  } else if (length > kMaxRequestBytes) {
-    const std::lock_guard<std::mutex> lock(self.stats_mutex_);
-    ++self.stats_.malformed;
-    answer = reply("error", nullptr, "message of " + std::to_string(length) + " bytes: at most " +
-                                         std::to_string(kMaxRequestBytes) + "; closing").dump();
-    keep = false;
-  } else {
-    answer = self.handle_message(client->may_control, std::string_view(data, length));
-  }
-  {
-    const std::lock_guard<std::mutex> lock(client->mutex);
-    if (client->replies.size() < kMaxReplies) {
-      client->replies.push_back(std::move(answer));
+  try {
+    auto* holder = static_cast<std::shared_ptr<Client>*>(mg_get_user_connection_data(conn));
+    if (holder == nullptr) {
+      return 0;
     }
+    const std::shared_ptr<Client>& client = *holder;
+    const int opcode = bits & 0x0F;
+    if (opcode == MG_WEBSOCKET_OPCODE_CONNECTION_CLOSE) {
+      return 0;
+    }
+    if (opcode == MG_WEBSOCKET_OPCODE_PING || opcode == MG_WEBSOCKET_OPCODE_PONG) {
+      return 1;
+    }
+    std::string answer;
+    bool keep = true;
+    if (opcode != MG_WEBSOCKET_OPCODE_TEXT || (bits & 0x80) == 0) {
+      const std::lock_guard<std::mutex> lock(self.stats_mutex_);
+      ++self.stats_.malformed;
+      answer = text_of(reply("error", nullptr, "expected one unfragmented text frame of JSON"));
+    } else if (length > kMaxRequestBytes) {
+      const std::lock_guard<std::mutex> lock(self.stats_mutex_);
+      ++self.stats_.malformed;
+      answer = text_of(reply("error", nullptr, "message of " + std::to_string(length) + " bytes: at most " +
+                                                   std::to_string(kMaxRequestBytes) + "; closing"));
+      keep = false;
+    } else {
+      answer = self.handle_message(client->may_control, std::string_view(data, length));
+    }
+    {
+      const std::lock_guard<std::mutex> lock(client->mutex);
+      if (client->replies.size() < kMaxReplies) {
+        client->replies.push_back(std::move(answer));
+      }
+    }
+    client->wake.notify_all();
+    return keep ? 1 : 0;
+  } catch (...) {
+    return 0;  // closes this connection; the server and the job go on
   }
-  client->wake.notify_all();
-  return keep ? 1 : 0;
 }
 
 void HmiServer::on_ws_close(const mg_connection* conn, void* self_pointer) {
   auto& self = *static_cast<HmiServer*>(self_pointer);
   auto* holder = static_cast<std::shared_ptr<Client>*>(mg_get_user_connection_data(conn));
   if (holder == nullptr) {
-    const std::lock_guard<std::mutex> lock(self.clients_mutex_);
-    if (self.pending_connections_.load() > 0) {
-      --self.pending_connections_;  // refused or failed before it was ready
-    }
-    return;
+    return;  // refused, or never ready
   }
   std::shared_ptr<Client> client = *holder;
   delete holder;
@@ -420,6 +445,7 @@ void HmiServer::on_ws_close(const mg_connection* conn, void* self_pointer) {
     client->closed = true;
   }
   client->wake.notify_all();
+  // Its sender may be in a write: civetweb's stop flag (at stop()) or the write timeout ends it.
   std::call_once(client->joined, [&] {
     if (client->sender.joinable()) {
       client->sender.join();
@@ -430,6 +456,15 @@ void HmiServer::on_ws_close(const mg_connection* conn, void* self_pointer) {
 }
 
 void HmiServer::send_loop(const std::shared_ptr<Client>& client) {
+  try {
+    send_messages(client);
+  } catch (...) {
+    const std::lock_guard<std::mutex> lock(client->mutex);
+    client->closed = true;  // out of memory: this client gets nothing more
+  }
+}
+
+void HmiServer::send_messages(const std::shared_ptr<Client>& client) {
   for (;;) {
     std::string message;
     {
@@ -463,6 +498,15 @@ void HmiServer::send_loop(const std::shared_ptr<Client>& client) {
 }
 
 void HmiServer::frame_loop() {
+  try {
+    build_frames();
+  } catch (...) {
+    // Out of memory building a frame: the display stops updating (its clients see no frames and
+    // say so); the job goes on.
+  }
+}
+
+void HmiServer::build_frames() {
   const auto period = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
       std::chrono::duration<double>(1.0 / options_.frame_hz));
   auto next = std::chrono::steady_clock::now() + period;
@@ -486,7 +530,7 @@ void HmiServer::frame_loop() {
     bool want_snapshot = false;
     for (const auto& client : clients) {
       const std::lock_guard<std::mutex> lock(client->mutex);
-      want_snapshot = want_snapshot || client->need_snapshot || !client->pending.empty();
+      want_snapshot = want_snapshot || (!client->closed && (client->need_snapshot || !client->pending.empty()));
     }
     const nlohmann::json server = server_json();
     nlohmann::json frame_json, snapshot_json;
@@ -499,8 +543,8 @@ void HmiServer::frame_loop() {
       }
     }
     // Serialised outside the lock: the feeding threads wait only for the state's copy.
-    const std::string frame = frame_json.dump();
-    const std::string snapshot = want_snapshot ? snapshot_json.dump() : std::string();
+    const std::string frame = text_of(frame_json);
+    const std::string snapshot = want_snapshot ? text_of(snapshot_json) : std::string();
     std::uint64_t dropped = 0, snapshots = 0;
     for (const auto& client : clients) {
       {

@@ -102,8 +102,11 @@ class HmiServer final : public control::DisplayFeed {
   static void on_ws_ready(mg_connection* conn, void* self);
   static int on_ws_data(mg_connection* conn, int bits, char* data, std::size_t length, void* self);
   static void on_ws_close(const mg_connection* conn, void* self);
+  static int serve_http(mg_connection* conn, HmiServer& self);
   void frame_loop();
+  void build_frames();
   void send_loop(const std::shared_ptr<Client>& client);
+  void send_messages(const std::shared_ptr<Client>& client);
   [[nodiscard]] nlohmann::json server_json() const;
 
   HmiServerOptions options_;
@@ -120,7 +123,6 @@ class HmiServer final : public control::DisplayFeed {
 
   mutable std::mutex clients_mutex_;
   std::vector<std::shared_ptr<Client>> clients_;
-  std::atomic<int> pending_connections_{0};
 
   mutable std::mutex stats_mutex_;
   HmiServerStats stats_;

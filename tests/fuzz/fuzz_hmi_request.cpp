@@ -7,7 +7,11 @@
 #include <string>
 #include <string_view>
 
+#include <nlohmann/json.hpp>
+
 #include "firmware/hmi/hmi_requests.hpp"
+#include "firmware/hmi/hmi_server.hpp"
+#include "firmware/tables/part_tables.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
 
 using stencil::fuzz::require;
@@ -15,6 +19,16 @@ using stencil::fuzz::require;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::hmi;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
+  // The server's whole answer, as a client would get it: always valid JSON, never an exception.
+  static const stencil::tables::PartTables part{};
+  static HmiServer server({}, part, stencil::control::ControllerConfig{});
+  for (const bool may_control : {false, true}) {
+    const nlohmann::json answer = nlohmann::json::parse(server.handle_message(may_control, text), nullptr, false);
+    require(answer.is_object() && answer.contains("type"));
+  }
+  stencil::control::Command command{};
+  while (server.pop_command(command)) {
+  }
   Request request;
   std::string error;
   if (!parse_request(text, request, error)) {

@@ -222,6 +222,16 @@ TEST(HmiAccess, BeyondLoopbackATokenIsNeededAndOnlyItsHolderMayControl) {
   CHECK_FALSE(may_control("s3cret-token", "S3cret-token"));
 }
 
+TEST(HmiAccess, OnlyThisServersOwnPageMayOpenTheSocket) {
+  CHECK(same_origin("http://127.0.0.1:8080", "127.0.0.1:8080"));
+  CHECK(same_origin("https://rig:8443", "rig:8443"));
+  CHECK_FALSE(same_origin("http://evil.example", "127.0.0.1:8080"));
+  CHECK_FALSE(same_origin("http://127.0.0.1:8081", "127.0.0.1:8080"));
+  CHECK_FALSE(same_origin("http://127.0.0.1:8080.evil", "127.0.0.1:8080"));
+  CHECK_FALSE(same_origin("null", "127.0.0.1:8080"));
+  CHECK_FALSE(same_origin("http://127.0.0.1:8080", ""));
+}
+
 TEST_GROUP(HmiRequests){};
 
 TEST(HmiRequests, WellFormedRequestsAreParsed) {
@@ -291,6 +301,10 @@ TEST(HmiLiveState, TheTouchedSetIsMirroredFromTheRecordsAndSentAsDeltasThenWhole
   CHECK(second["touched"].size() >= 1U);
   CHECK_EQUAL(second["touched"].size(), second["touched_count"].get<std::size_t>());
   CHECK(second["coverage"].get<double>() > 0.0);
+  // A record in contact whose count did not grow added nothing in the cycle: nothing here either.
+  LiveState untouched(prism.part, config(), limits_of(config()));
+  untouched.on_record(record_at(1, Eigen::Vector3d(25.0, 12.5, 6.0), 0));
+  CHECK_EQUAL(0U, untouched.touched_count());
   // Nothing new: an empty delta; the snapshot has them all.
   state.on_record(record_at(3, Eigen::Vector3d(25.0, 12.5, 6.0), second["touched_count"].get<std::uint32_t>()));
   nlohmann::json third = state.frame(3, server);
@@ -390,8 +404,13 @@ TEST(HmiServer, RequestsAreCheckedAndOnlyAcceptedOnesReachTheCommandQueue) {
   CHECK(command.kind == control::CommandKind::SetCoupling);
   DOUBLES_EQUAL(0.8, command.value, 0.0);
   CHECK_FALSE(server.pop_command(command));
+  // Text quoted back in an error that would end mid-character is still sent as valid JSON (an
+  // exception here would end the program from inside civetweb).
+  const std::string cut = R"({"type":")" + std::string(39, 'a') + "\xc3\xa9\"}";
+  const nlohmann::json quoted = nlohmann::json::parse(server.handle_message(false, cut));
+  STRCMP_EQUAL("error", quoted["type"].get<std::string>().c_str());
   const HmiServerStats stats = server.stats();
-  CHECK_EQUAL(1U, stats.malformed);
+  CHECK_EQUAL(2U, stats.malformed);
   CHECK_EQUAL(3U, stats.refused);
   CHECK_EQUAL(1U, stats.accepted);
 }
@@ -480,6 +499,21 @@ TEST(HmiServer, AClientGetsASnapshotThenFramesAndAnswersToItsRequests) {
   CHECK_FALSE(server.pop_command(command));
   CHECK_EQUAL(2U, server.stats().clients);
   CHECK_EQUAL(1U, server.stats().malformed);
+  // Another site's page is refused before the handshake; failed handshakes (a key too long for
+  // civetweb) hold no slot: a client still gets in after more of them than there are slots.
+  const std::string foreign = http(server.port(), "GET /ws HTTP/1.1\r\nHost: 127.0.0.1:" + std::to_string(server.port()) +
+                                                      "\r\nOrigin: http://evil.example\r\nUpgrade: websocket\r\n"
+                                                      "Connection: Upgrade\r\nSec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\n"
+                                                      "Sec-WebSocket-Version: 13\r\n\r\n");
+  CHECK(foreign.find("101") == std::string::npos);
+  for (int i = 0; i < 10; ++i) {
+    static_cast<void>(http(server.port(), "GET /ws HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n"
+                                          "Sec-WebSocket-Key: " + std::string(80, 'k') + "\r\nSec-WebSocket-Version: 13\r\n\r\n"));
+  }
+  Listener late;
+  CHECK(late.open(server.port()));
+  CHECK(late.wait_for("snapshot", 1));
+  late.close();
   watcher.close();
   operator_.close();
   server.stop();
