@@ -64,6 +64,7 @@ bool Display::start(const DisplayOptions& options, const tables::PartTables& par
     return false;
   }
   server_options.token = options.token;
+  server_options.virtual_clock = !config.count_overruns;  // lateness means nothing there
   server_options.assets_dir = options.assets_dir;
   if (server_options.assets_dir.empty()) {
     std::error_code ec;

@@ -372,7 +372,10 @@ void HmiServer::on_ws_ready(mg_connection* conn, void* self_pointer) {
     const int length = mg_get_var(query, std::strlen(query), "token", token, sizeof token);
     client->may_control = may_control(self.options_.token, length > 0 ? std::string_view(token, static_cast<std::size_t>(length))
                                                                       : std::string_view());
-    nlohmann::json hello{{"type", "hello"}, {"may_control", client->may_control}, {"frame_hz", self.options_.frame_hz}};
+    nlohmann::json hello{{"type", "hello"},
+                         {"may_control", client->may_control},
+                         {"frame_hz", self.options_.frame_hz},
+                         {"virtual_clock", self.options_.virtual_clock}};
     if (!client->may_control) {
       hello["reason"] = "watch-only: open the page with ?token=... (--hmi-token) to change anything";
     }

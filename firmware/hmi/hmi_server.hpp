@@ -41,6 +41,7 @@ struct HmiServerOptions {
   std::string assets_dir;  // the built page (index.html, app.js, ...): only these files are served
   int max_clients = 8;
   double frame_hz = 20.0;
+  bool virtual_clock = false;  // the cycle runs on a virtual clock: its loop timing is 0 by construction
   int write_timeout_ms = 1000;  // a client that takes no bytes for this long is dropped
 };
 

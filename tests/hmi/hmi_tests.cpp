@@ -478,6 +478,7 @@ TEST(HmiServer, AClientGetsASnapshotThenFramesAndAnswersToItsRequests) {
   CHECK(watcher.wait_for("hello", 1));
   CHECK(operator_.wait_for("hello", 1));
   CHECK_FALSE(watcher.of_type("hello")[0]["may_control"].get<bool>());
+  CHECK_FALSE(watcher.of_type("hello")[0]["virtual_clock"].get<bool>());
   CHECK(operator_.of_type("hello")[0]["may_control"].get<bool>());
   CHECK(watcher.wait_for("snapshot", 1));
   CHECK(watcher.wait_for("frame", 5));

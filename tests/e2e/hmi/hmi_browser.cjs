@@ -73,6 +73,12 @@ function startSim() {
       fail('the 3-D view is blank');
     }
 
+    // --speed 5 is the virtual clock: the page says what that means for the loop plots.
+    const clockNote = await page.textContent('#clock-note');
+    if (!clockNote.includes('virtual clock')) {
+      fail(`the page does not say the loop timing is on a virtual clock: '${clockNote}'`);
+    }
+
     // The coverage figure rises as the raster touches the part.
     const coverageText = () => page.textContent('#coverage');
     const startCoverage = Number(await page.evaluate(() => document.body.dataset.coverage));

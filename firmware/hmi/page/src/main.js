@@ -59,6 +59,9 @@ function onMessage(message) {
       if (!mayControl) {
         $('param-message').textContent = message.reason;
       }
+      $('clock-note').textContent = message.virtual_clock
+        ? 'virtual clock (--fast or --speed N): the loop\'s wake-up latency and compute time are 0 by construction'
+        : '';
       break;
     case 'snapshot':
       limits = message.limits;
