@@ -215,7 +215,9 @@ TEST(SimulatedHapticDevice, OnItsOwnThreadZeroesForceSoonAfterTheHostStops) {
   CHECK_TRUE(zeroed_after_ns > sim::kDefaultHostWatchdogNs);
   std::printf("\n  simulated device on its thread: force zeroed %.1f ms after the host's last beat (watchdog %.0f ms)\n",
               static_cast<double>(zeroed_after_ns) * 1e-6, static_cast<double>(sim::kDefaultHostWatchdogNs) * 1e-6);
-  CHECK_TRUE(device_thread.cycles() > 10);
+  // It ran: it took a command and later tripped, so at least two cycles (on a starved host, as under
+  // ASan beside other tests, it may get few more than that in the watchdog's 20 ms).
+  CHECK_TRUE(device_thread.cycles() >= 2);
 }
 
 TEST(SimulatedHapticDevice, AScriptedTrajectoryMovesLinearlyThroughItsWaypointsThenHolds) {
