@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak soak-asan clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak soak-asan fresh-check clean help
 
 all: build
 
@@ -15,6 +15,7 @@ help:
 	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
 	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
+	@echo "make fresh-check README's two commands in a clean Debian 12 root (mmdebstrap; needs root; about half an hour)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
 
@@ -79,6 +80,13 @@ fuzz: deps
 	cmake --preset fuzz -DSTENCIL_FUZZ_SECONDS=$(FUZZ_SECONDS)
 	cmake --build --preset fuzz
 	ctest --preset fuzz
+
+# A check, not a test: README's two commands in a clean Debian 12 root made with mmdebstrap, the
+# committed HEAD cloned into it (toolchain/fresh-check.sh; needs root). Run it after any change to
+# the dependencies, the lock file or install-deps.sh.
+fresh-check:
+	@bash toolchain/install-deps.sh --fresh-check
+	bash toolchain/fresh-check.sh build/fresh-check
 
 clean:
 	rm -rf build

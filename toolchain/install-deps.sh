@@ -2,21 +2,25 @@
 # Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
 # --cross also installs the aarch64-linux-gnu cross compiler and the arm64 libraries the firmware
 # links (zlib), for the `aarch64` preset. --latency adds cyclictest and stress-ng for make latency.
+# --fresh-check adds mmdebstrap, for make fresh-check.
 set -euo pipefail
 
 cross=0
 latency=0
+fresh_check=0
 for argument in "$@"; do
   case "$argument" in
     --cross) cross=1 ;;
     --latency) latency=1 ;;
+    --fresh-check) fresh_check=1 ;;
     -h|--help)
-      echo "usage: $0 [--cross] [--latency]"
+      echo "usage: $0 [--cross] [--latency] [--fresh-check]"
       echo "Installs the Debian packages the project needs (apt-get; as root or via sudo)."
       echo "  --cross   also the aarch64-linux-gnu cross compiler (for the aarch64 preset)"
       echo "  --latency also cyclictest (rt-tests) and stress-ng (for make latency)"
+      echo "  --fresh-check also mmdebstrap (for make fresh-check)"
       exit 0 ;;
-    *) echo "install-deps: unknown option '$argument' (expected --cross, --latency or --help)" >&2; exit 2 ;;
+    *) echo "install-deps: unknown option '$argument' (expected --cross, --latency, --fresh-check or --help)" >&2; exit 2 ;;
   esac
 done
 
@@ -41,7 +45,9 @@ packages=(
   fonts-dejavu-core  # text in that browser's screenshots
 )
 # The display's page is built with npm (three.js and esbuild, pinned by its package-lock.json): the
-# machine's own Node.js and npm when it has them, else Debian's.
+# machine's own Node.js and npm when it has them, else Debian's (Node 18 on Debian 12: every package
+# the lock file pins accepts it, and firmware/hmi/page/check-engines.cjs refuses a Node that some
+# pinned package does not, before the page is built and before the browser test).
 if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
   packages+=(nodejs npm)
 fi
@@ -50,6 +56,9 @@ if [ "$cross" -eq 1 ]; then
 fi
 if [ "$latency" -eq 1 ]; then
   packages+=(rt-tests stress-ng)
+fi
+if [ "$fresh_check" -eq 1 ]; then
+  packages+=(mmdebstrap)
 fi
 
 missing=()
