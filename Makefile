@@ -89,4 +89,5 @@ fresh-check:
 	bash toolchain/fresh-check.sh build/fresh-check
 
 clean:
-	rm -rf build
+	@# --one-file-system: a fresh-check root killed mid-run may still have the host's /dev, /proc and /sys bound inside it
+	rm -rf --one-file-system build

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <cstdint>
 
 #include "hal/clock.hpp"
@@ -50,6 +51,7 @@ enum class MachineRefusal : std::uint8_t {
   BadTarget,    // order not a permutation, or steps out of the controller's range
   Faulted,      // the fault latch is set
   DeadlineTooShort,  // the caller's time bound cannot cover the work
+  Aborted,      // the operator asked to stop (abort_on's flag) before the work was done
 };
 
 struct [[nodiscard]] MachineResult {
@@ -84,7 +86,12 @@ class MachineLink {
   virtual MachineResult start(MonotonicNs deadline_ns) = 0;
   // Seeks the home switch of every axis, then verifies the position by query. Motor steps count
   // from there; the slack of every axis is on the side homing approached from (reported by
-  // home_approach()).
+  // home_approach()). The deadline should allow homing_bound_ns().
+  // Set before start(): start() and home() look at *flag between commands and give up (refusal
+  // Aborted, outputs off) once it is true: a stop asked for while homing is taken within one step.
+  virtual void abort_on(const std::atomic<bool>* flag) = 0;
+  // The longest homing can take from anywhere in the travel (ns): the caller's deadline for it.
+  [[nodiscard]] virtual MonotonicNs homing_bound_ns() const = 0;
   virtual MachineResult home(MonotonicNs deadline_ns) = 0;
   // Manual homing for a rig without switches: the operator jogged the tool to the mark; this
   // position becomes motor step 0 of every axis.

@@ -51,7 +51,7 @@ unmount_root() {
 }
 trap unmount_root EXIT
 unmount_root
-rm -rf "$root"
+rm -rf --one-file-system "$root"  # never into a bind mount left by a killed run
 
 # Debian 12 as a fresh install sees it: the release, its updates and its security archive. The apt
 # variant is Essential plus apt, as minimal as a container image: whatever else the commands need,
@@ -117,7 +117,7 @@ grep -E '^(simulated|gouge|stock removed|coverage|safe state)' "$work/demo.log" 
 grep -E 'tests passed|tests failed' "$work/test.log" | sed 's/^/fresh-check: test: /' || true
 
 unmount_root
-if [ "$remove_root" -eq 1 ]; then rm -rf "$root"; fi
+if [ "$remove_root" -eq 1 ]; then rm -rf --one-file-system "$root"; fi
 if [ "${#failed[@]}" -ne 0 ]; then
   echo "fresh-check: FAILED: ${failed[*]}" >&2
   exit 1

@@ -101,7 +101,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
     result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
   }
   hal::Clock& clock = *job.machine_clock;
-  if (!machine->start(clock.now_ns() + 120'000'000'000)) {
+  // Wake-up and spindle in seconds; homing as long as the link says it can take from anywhere.
+  if (!machine->start(clock.now_ns() + job.machine->homing_bound_ns() + 20'000'000'000)) {
     result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
                                             : "the machine did not start (wake, home, spindle on)";
     return result;

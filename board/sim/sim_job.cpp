@@ -458,7 +458,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   if (realtime) {
     fake_runner = std::make_unique<stencil::sim::cy545::FakeCy545Runner>(fake);
   }
-  if (!machine->start(machine_clock.now_ns() + 120'000'000'000)) {
+  // Wake-up and spindle in seconds; homing as long as the link says it can take.
+  if (!machine->start(machine_clock.now_ns() + link.homing_bound_ns() + 20'000'000'000)) {
     result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
                                             : std::string("the machine did not start: ") + link.last_error();
     return result;

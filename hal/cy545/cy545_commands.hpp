@@ -43,6 +43,13 @@ struct CommandBytes {
                                    ((address & 0x07U) << 2U) | (read_strobe ? 0x20U : 0U));
 }
 inline constexpr std::uint8_t kWriteStrobeBit = 7;
+// The mode register's power-up value (manual, chapter 9 "Operating Mode Command"): bit 7 set selects
+// ASCII commands (clear: binary, which reads every later ASCII byte as a binary count or data), the
+// low bits standard serial output for query replies. The driver sets it explicitly, since whatever
+// ran before may have left another mode.
+inline constexpr std::uint8_t kAsciiMode = 0x80;
+// User bit 0 drives the MMC-4S's driver enable (bits 0-5 of "? B" read back the latches).
+inline constexpr std::uint8_t kDriverEnableBit = 0x01;
 // H 11H: seek until user bit 1 (the input mux's line while the read strobe is on) reads 0, i.e.
 // the home switch of the selected input opens: the chip steps down into the switch, then up out.
 inline constexpr std::uint8_t kHomeOnInputOpen = 0x11;

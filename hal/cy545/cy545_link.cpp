@@ -120,6 +120,82 @@ bool Cy545Link::wait_free(MonotonicNs deadline_ns) {
   }
 }
 
+bool Cy545Link::read_user_bits_when_free(std::uint8_t& levels, MonotonicNs deadline_ns) {
+  port_.discard_input();
+  // "? B" without its carriage return fits the chip's three-character buffer even while it steps;
+  // the carriage returns after it complete the line once the chip is free (see wait_free).
+  if (port_.write_all("? B", deadline_ns, clock_) != PortIo::Ok) {
+    return false;
+  }
+  bytes_sent_ += 3;
+  const MonotonicNs interval = config_.probe_interval_ns;
+  char reply[32];
+  std::size_t kept = 0;
+  while (true) {
+    if (port_.write_all("\r", deadline_ns, clock_) != PortIo::Ok) {
+      return false;
+    }
+    ++bytes_sent_;
+    const MonotonicNs now = clock_.now_ns();
+    if (now >= deadline_ns) {
+      return false;
+    }
+    std::size_t size = 0;
+    const PortIo io = port_.read_line(reply + kept, sizeof reply - kept, size, std::min(deadline_ns, now + interval), clock_);
+    bytes_received_ += size;
+    kept += size;
+    if (io == PortIo::TimedOut) {
+      continue;
+    }
+    const ReplyParse parsed = parse_reply({reply, kept}, 'B');
+    if (io != PortIo::Ok || parsed.status != ReplyStatus::Complete) {
+      return false;
+    }
+    levels = static_cast<std::uint8_t>(parsed.value);
+    return true;
+  }
+}
+
+bool Cy545Link::force_outputs_off(MonotonicNs deadline_ns) {
+  outputs_confirmed_off_ = false;
+  running_ = false;  // whatever was under way: the query below waits for the chip itself
+  std::uint8_t levels = 0;
+  if (!read_user_bits_when_free(levels, deadline_ns)) {
+    std::snprintf(last_error_, sizeof last_error_,
+                  "the controller did not answer before the spindle-off and drivers-off commands: the spindle and "
+                  "drivers may still be on; cut the mill's power");
+    return false;
+  }
+  // The spindle's output latched off with the drivers already off (bit 0 is a level), then every bit
+  // 0-5 low; each command on its own, so that none arrives while the chip takes the one before.
+  CommandBytes commands[4]{};
+  const bool built = bit_command(write_bits_code(false, false, config_.spindle_output, false), commands[0]) &&
+                     bit_command(kWriteStrobeBit, commands[1]) && clear_bit_command(kWriteStrobeBit, commands[2]) &&
+                     bit_command(write_bits_code(false, false, 0, false), commands[3]);
+  for (const CommandBytes& command : commands) {
+    if (!built || port_.write_all(command.view(), deadline_ns, clock_) != PortIo::Ok) {
+      std::snprintf(last_error_, sizeof last_error_,
+                    "the spindle-off and drivers-off commands could not be written to the port: the spindle and "
+                    "drivers may still be on; cut the mill's power");
+      return false;
+    }
+    bytes_sent_ += command.size;
+    clock_.sleep_until_ns(clock_.now_ns() + config_.command_settle_ns);
+  }
+  if (!read_user_bits_when_free(levels, deadline_ns) || (levels & 0xBFU) != 0) {
+    std::snprintf(last_error_, sizeof last_error_,
+                  "the controller did not confirm its outputs off (\"? B\" %s): the spindle and drivers may still be "
+                  "on; cut the mill's power",
+                  (levels & 0xBFU) != 0 ? "reads bits still set" : "unanswered");
+    return false;
+  }
+  outputs_confirmed_off_ = true;
+  spindle_on_ = false;
+  drivers_on_ = false;
+  selected_channel_ = -1;
+  return true;
+}
+
 bool Cy545Link::write_bytes(std::string_view bytes, MonotonicNs deadline_ns) {
   const PortIo io = port_.write_all(bytes, deadline_ns, clock_);
   bytes_sent_ += bytes.size();
@@ -214,6 +290,9 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
     if (clock_.now_ns() >= deadline_ns) {
       break;
     }
+    if (abort_asked()) {
+      return refuse(MachineRefusal::Aborted);
+    }
     const PortIo io = port_.write_all("\r", deadline_ns, clock_);
     bytes_sent_ += 1;
     if (io == PortIo::Closed) {
@@ -235,27 +314,174 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
     answered = read == PortIo::Ok && parse_reply({reply, size}, 'P').status == ReplyStatus::Complete;
   }
   if (!answered) {
-    std::snprintf(last_error_, sizeof last_error_, "the controller never answered \"? P\" (%d attempts)",
+    std::snprintf(last_error_, sizeof last_error_,
+                  "the controller never answered \"? P\" (%d attempts): check the cable and the baud rate; a chip "
+                  "left in binary mode (mode register bit 7 clear) answers only after a power cycle",
                   config_.start_attempts);
     return fail(MachineFault::NoAnswer);
   }
-  // Initialise: I clears the position and the user bits (drivers off), then rates, no ramp, mode 0.
+  // Initialise: I clears the position and the chip's user bits, ASCII mode said explicitly, then
+  // rates and no ramp.
   const bool initialised = bare_command('I', command) && send(command, deadline_ns) &&
+                           number_command('O', kAsciiMode, 255, command) && send(command, deadline_ns) &&
                            number_command('R', config_.step_rate, 27000, command) && send(command, deadline_ns) &&
                            number_command('F', config_.step_rate, 27000, command) && send(command, deadline_ns) &&
-                           number_command('S', 0, 255, command) && send(command, deadline_ns) &&
-                           number_command('O', 0, 255, command) && send(command, deadline_ns);
+                           number_command('S', 0, 255, command) && send(command, deadline_ns);
   if (!initialised) {
     return fault_ != MachineFault::None ? MachineResult{false, MachineRefusal::None, fault_}
                                         : refuse(MachineRefusal::DeadlineTooShort);
+  }
+  // Every output to its safe value before anything moves: the board's latches keep what the last run
+  // left (a spindle still turning after a crash), which neither "I" nor a new program clears.
+  if (!force_outputs_off(deadline_ns)) {
+    return fail(MachineFault::NoAnswer);
   }
   position_register_ = 0;
   selected_channel_ = -1;
   drivers_on_ = false;
   spindle_on_ = false;
   homed_ = false;
+  rate_sent_ = config_.step_rate;
   state_ = MachineState::Ready;
   return {true, MachineRefusal::None, MachineFault::None};
+}
+
+MonotonicNs Cy545Link::homing_bound_ns() const {
+  // Per axis: out of the switch's zone and the whole travel at the approach rate, then the slow
+  // departure (at most two legs' worth of steps); every leg's commands and switch reads bounded by
+  // three reply timeouts; three axes, and a margin. A bound, not an estimate: near home it is seconds.
+  const MonotonicNs query_ns = 3 * config_.reply_timeout_ns;  // a leg's commands, the reads, their answers
+  const std::int64_t fast_steps = config_.home_switch_zone_steps + config_.homing_travel_steps;
+  const std::int64_t legs = fast_steps / std::max(config_.homing_chunk_steps, 1) + 2;
+  const std::int64_t slow_steps = std::max(config_.homing_chunk_steps, 1) + config_.homing_slack_steps;
+  const MonotonicNs axis_ns = steps_time_ns(fast_steps, config_.homing_rate) + legs * query_ns +
+                              steps_time_ns(slow_steps, config_.homing_slow_rate) +
+                              slow_steps * (query_ns + config_.pace_margin_ns);
+  return 3 * axis_ns + 10 * kSecond;
+}
+
+MachineResult Cy545Link::aborted(MonotonicNs deadline_ns) {
+  static_cast<void>(force_outputs_off(deadline_ns));
+  homed_ = false;
+  state_ = fault_ == MachineFault::None ? MachineState::Stopped : MachineState::Fault;
+  std::snprintf(last_error_, sizeof last_error_, "homing stopped as asked; %s",
+                outputs_confirmed_off_ ? "spindle and drivers off" : "the outputs could not be confirmed off");
+  return refuse(MachineRefusal::Aborted);
+}
+
+Cy545Link::SwitchReading Cy545Link::read_home_switch(std::size_t axis, MonotonicNs deadline_ns, int reads) {
+  int closed = 0;
+  for (int read = 0; read < reads; ++read) {
+    std::uint8_t levels = 0;
+    // The first read waits out the leg before it (the chip answers once it is free), the rest only a reply.
+    const MonotonicNs from = running_ ? std::max(busy_bound_ns_, clock_.now_ns()) : clock_.now_ns();
+    const MonotonicNs bound = std::min(deadline_ns, from + config_.reply_timeout_ns);
+    running_ = false;
+    if (!read_user_bits_when_free(levels, bound)) {
+      std::snprintf(last_error_, sizeof last_error_, "homing axis %c: the controller did not answer \"? B\" within %lld ms",
+                    "XYZ"[axis], static_cast<long long>(config_.reply_timeout_ns / 1'000'000));
+      latch_fault(MachineFault::Timeout);
+      return SwitchReading::Failed;
+    }
+    const bool level = (levels & 0x02U) != 0;  // user bit 1: the input mux, with the read strobe on
+    closed += level == config_.home_switch_closed_level[axis] ? 1 : 0;
+  }
+  return closed == reads ? SwitchReading::Closed : closed == 0 ? SwitchReading::Open : SwitchReading::Bouncing;
+}
+
+bool Cy545Link::homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns) {
+  CommandBytes command{};
+  if (rate != rate_sent_) {
+    if (!number_command('R', rate, 27000, command) || !send(command, deadline_ns)) {
+      return false;
+    }
+    rate_sent_ = rate;
+  }
+  const auto count = static_cast<std::uint32_t>(std::abs(steps));
+  if (!number_command('N', count, kMax24, command) || !send(command, deadline_ns) ||
+      !bare_command(steps > 0 ? '+' : '-', command) || !send(command, deadline_ns) || !bare_command('G', command) ||
+      !send(command, deadline_ns)) {
+    return false;
+  }
+  position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + steps) & kMax24;
+  const MonotonicNs leg = steps_time_ns(count, rate);
+  started_running(leg, leg + config_.pace_margin_ns);
+  return true;
+}
+
+// The approach runs toward the switch (-), the departure away from it (+): every axis's switch is
+// closed below its home (rig_constants.hpp), so the last steps of homing are + (home_approach()).
+bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
+  const char name = "XYZ"[axis];
+  if (!select_channel(config_.motor_channel[axis], deadline_ns) ||
+      !send_bits(write_bits_code(true, false, config_.home_input[axis], true), deadline_ns)) {
+    return false;
+  }
+  selected_channel_ = -1;  // the address lines now carry the input's number
+  const std::int32_t chunk = std::max(config_.homing_chunk_steps, 1);
+  const int debounce = std::max(config_.homing_debounce_reads, 1);
+  // Before anything moves: a closed switch means the axis is inside its zone; leave it first.
+  SwitchReading reading = read_home_switch(axis, deadline_ns, debounce);
+  for (std::int32_t left = 0; reading != SwitchReading::Open; left += chunk) {
+    if (reading == SwitchReading::Failed || abort_asked()) {
+      return false;
+    }
+    if (left >= config_.home_switch_zone_steps) {
+      std::snprintf(last_error_, sizeof last_error_,
+                    "homing axis %c: its home switch still reads closed %d steps out of its zone: check its wiring and "
+                    "the closed level in the configuration",
+                    name, left);
+      latch_fault(MachineFault::PositionMismatch);
+      return false;
+    }
+    if (!homing_leg(chunk, config_.homing_rate, deadline_ns)) {
+      return false;
+    }
+    reading = read_home_switch(axis, deadline_ns, debounce);
+  }
+  // The approach: until the switch reads anything but open (closed, or bouncing at its edge).
+  for (std::int32_t travelled = 0; reading == SwitchReading::Open; travelled += chunk) {
+    if (abort_asked()) {
+      return false;
+    }
+    if (travelled >= config_.homing_travel_steps) {
+      std::snprintf(last_error_, sizeof last_error_,
+                    "homing axis %c: no home switch within %d steps of travel: check the switch, its wiring and the "
+                    "closed level in the configuration",
+                    name, travelled);
+      latch_fault(MachineFault::PositionMismatch);
+      return false;
+    }
+    if (!homing_leg(-chunk, config_.homing_rate, deadline_ns)) {
+      return false;
+    }
+    reading = read_home_switch(axis, deadline_ns, debounce);
+  }
+  if (reading == SwitchReading::Failed) {
+    return false;
+  }
+  // The departure, one slow step at a time with a read after each, until a read says open and the
+  // debounce's reads agree: that edge is home. (A bouncing switch can end it early by at most its
+  // bouncing band: the repeatability of home, measured in the tests.)
+  for (std::int32_t stepped = 0; reading != SwitchReading::Open; ++stepped) {
+    if (reading == SwitchReading::Failed || abort_asked()) {
+      return false;
+    }
+    if (stepped >= chunk + config_.homing_slack_steps) {
+      std::snprintf(last_error_, sizeof last_error_, "homing axis %c: its home switch did not settle open within %d steps",
+                    name, stepped);
+      latch_fault(MachineFault::PositionMismatch);
+      return false;
+    }
+    if (!homing_leg(1, config_.homing_slow_rate, deadline_ns)) {
+      return false;
+    }
+    reading = read_home_switch(axis, deadline_ns, 1);
+    if (reading == SwitchReading::Open) {
+      reading = read_home_switch(axis, deadline_ns, debounce);
+    }
+  }
+  return true;
 }
 
 MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
@@ -265,35 +491,36 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
   if (state_ == MachineState::Closed || state_ == MachineState::Open) {
     return refuse(MachineRefusal::NotHomed);
   }
-  const MonotonicNs seek = steps_time_ns(config_.homing_travel_steps, config_.homing_rate) + config_.pace_margin_ns;
-  if (deadline_ns - clock_.now_ns() < 3 * seek + 4 * config_.reply_timeout_ns) {
-    return refuse(MachineRefusal::DeadlineTooShort);  // nothing sent: the seeks could outlast the bound
-  }
-  CommandBytes command{};
-  if (!number_command('F', config_.homing_rate, 27000, command) || !send(command, deadline_ns)) {
-    return {false, MachineRefusal::None, fault_};
+  if (deadline_ns - clock_.now_ns() < homing_bound_ns()) {
+    std::snprintf(last_error_, sizeof last_error_, "homing refused: %.0f s given, it can take up to %.0f s",
+                  static_cast<double>(deadline_ns - clock_.now_ns()) / 1e9, static_cast<double>(homing_bound_ns()) / 1e9);
+    return refuse(MachineRefusal::DeadlineTooShort);  // nothing sent: homing could outlast the bound
   }
   // Z first: after a crash or a stop mid-cut the tool may stand in the stock, and only raising it
   // first takes it out without ploughing sideways through the work.
   for (const std::size_t axis : {std::size_t{2}, std::size_t{0}, std::size_t{1}}) {
-    // The axis's channel, its switch on the input line, then the seek (busy for an unknown time up
-    // to the longest travel: nothing is sent until that has passed).
-    if (!select_channel(config_.motor_channel[axis], deadline_ns) ||
-        !send_bits(write_bits_code(true, false, config_.home_input[axis], true), deadline_ns) ||
-        !home_command(kHomeOnInputOpen, command) || !send(command, deadline_ns)) {
+    if (!home_axis(axis, deadline_ns)) {
+      if (fault_ == MachineFault::None && abort_asked()) {
+        return aborted(deadline_ns);
+      }
+      return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
+    }
+    // This axis's edge is its zero; the register is shared, so each axis is zeroed in turn.
+    CommandBytes zero{};
+    if (!number_command('A', 0, kMax24, zero) || !send(zero, deadline_ns)) {
       return {false, MachineRefusal::None, fault_};
     }
-    selected_channel_ = -1;  // the address lines now carry the input's number
-    position_register_ = 0;  // where the seek leaves it
-    started_running(0, seek);
+    position_register_ = 0;
   }
-  // Read strobe off, rates back, then the position must be the home's.
+  // Read strobe off, the moving rate back, then the position must be the home's.
+  CommandBytes command{};
   std::uint32_t position = 1;
   if (!send_bits(write_bits_code(true, false, config_.motor_channel[0], false), deadline_ns) ||
-      !number_command('F', config_.step_rate, 27000, command) || !send(command, deadline_ns) ||
+      !number_command('R', config_.step_rate, 27000, command) || !send(command, deadline_ns) ||
       !query('P', position, deadline_ns)) {
     return {false, MachineRefusal::None, fault_};
   }
+  rate_sent_ = config_.step_rate;
   if (position != 0) {
     std::snprintf(last_error_, sizeof last_error_, "after homing the controller reports position %u, not 0", position);
     return fail(MachineFault::PositionMismatch);
@@ -425,21 +652,19 @@ void Cy545Link::resume() {
 
 MachineResult Cy545Link::stop(MonotonicNs deadline_ns) {
   hold();
-  if (fault_ != MachineFault::None) {
-    return refuse(MachineRefusal::Faulted);
-  }
-  // Spindle off (its output latched with the drivers still on), then every bit 0-5 low: drivers off.
-  const bool spindle_off = send_bits(write_bits_code(true, false, config_.spindle_output, false), deadline_ns) &&
-                           latch(deadline_ns);
-  if (!spindle_off || !send_bits(write_bits_code(false, false, 0, false), deadline_ns)) {
-    return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
-  }
-  spindle_on_ = false;
-  drivers_on_ = false;
-  selected_channel_ = -1;
   homed_ = false;  // limp axes may have moved: home again
-  state_ = MachineState::Stopped;
-  return {true, MachineRefusal::None, MachineFault::None};
+  // Whatever fault is latched: it says the line misbehaved, not that the chip stopped listening, and a
+  // spindle left turning is the worst way for a stop to end.
+  if (!force_outputs_off(deadline_ns)) {
+    if (fault_ == MachineFault::None) {
+      latch_fault(MachineFault::Timeout);
+    }
+    return {false, MachineRefusal::None, fault_};
+  }
+  if (fault_ == MachineFault::None) {
+    state_ = MachineState::Stopped;
+  }
+  return {true, MachineRefusal::None, fault_};
 }
 
 MachineStatus Cy545Link::status() const {

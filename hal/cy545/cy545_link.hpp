@@ -8,14 +8,22 @@
 //   + or -              its direction
 //   G                   go; the chip is busy for steps / rate seconds and reads nothing meanwhile
 //
+// Start-up: "I", "O 128" (ASCII commands: bit 7 of the mode register; "O 0" would put the chip
+// into binary mode, manual chapter 9), the rates, then every output to its safe value: spindle off
+// and drivers off, whatever a previous run left latched on the MMC-4S board (its latches survive a
+// program's restart and the chip's "I"). stop() does the same whatever fault is latched (a fault
+// says the line misbehaved, not that the chip is deaf) and confirms it with "? B".
+//
 // The chip has a three-character input buffer and ignores input while a move runs, so nothing is
 // sent before the previous move is known to be over: on a real port CTS holds the bytes (the chip
 // drops CTS while busy); on either port the driver waits the move's computed time, then asks "? P"
 // and sends carriage returns until the answer comes (the three characters fit the buffer even if
 // the chip is still busy; see wait_free), which also checks every step was made. Homing: per axis, select the channel, put its home switch on the input line (B <61H + 4c>H:
-// read strobe on, input address c) and seek (H 11H: down into the switch, up until it opens). The
-// chip keeps one position register for every channel; the driver tracks it (relative moves add to
-// it) and compares it with "? P" in verify().
+// read strobe on, input address c), then step in short legs, reading the switch ("? B", bit 1)
+// between them (see Cy545Config): not the chip's H command, which seeks for as long as it takes
+// while the chip reads nothing, so that neither a stop nor a bound can reach it. The chip keeps one
+// position register for every channel; the driver tracks it (relative moves add to it) and
+// compares it with "? P" in verify().
 //
 // Rates are given to the chip in steps per second (R, F), as the simulated CY545 takes them; the
 // real chip takes an index into its rate table: a rig build must convert (not done: no rig here).
@@ -34,13 +42,29 @@ namespace stencil::hal::cy545 {
 
 struct Cy545Config {
   std::uint32_t step_rate = 1000;            // steps/s of every move (R and F: no ramp)
-  std::uint32_t homing_rate = 1000;          // steps/s while seeking home
-  std::int32_t homing_travel_steps = 40960;  // the longest seek of one axis (64 mm), bounds its wait
+  // Homing, per axis: the switch read first (closed: leave it), then an approach in chunks of
+  // homing_chunk_steps at homing_rate with the switch read after each, until it closes (or
+  // homing_travel_steps: a fault), then a slow departure one step at a time at homing_slow_rate
+  // until it reads open homing_debounce_reads times in a row: that edge is home.
+  std::uint32_t homing_rate = 800;           // steps/s (1.25 mm/s: under the Sherline's 1.4 mm/s)
+  std::uint32_t homing_slow_rate = 200;      // steps/s for the last, edge-finding steps
+  std::int32_t homing_chunk_steps = 64;      // 0.1 mm: how far the approach may run into the switch
+  // The departure turns the backlash before the axis moves: at most a leg plus this many steps.
+  std::int32_t homing_slack_steps = 256;     // 0.4 mm: above the Sherline's largest backlash (80 steps)
+  std::int32_t homing_travel_steps = 40960;  // the longest approach of one axis (64 mm)
+  std::int32_t home_switch_zone_steps = 2560;  // the switch's closed zone (4 mm): a switch still closed this far out is miswired
+  int homing_debounce_reads = 3;             // equal reads in a row that settle the switch's state
+  // The level user bit 1 reads, through the input mux, while an axis's home switch is CLOSED: a rig
+  // fact (normally-open switches pulled up read 0), never guessed: wrong, the approach runs away.
+  std::array<bool, 3> home_switch_closed_level = {true, true, true};
   double update_period_s = 1.0 / 30.0;       // a move that takes longer is refused
   MonotonicNs reply_timeout_ns = 50'000'000; // a query's answer
   MonotonicNs pace_margin_ns = 5'000'000;    // beyond its computed time a move is overdue (+ reply_timeout: a fault)
   MonotonicNs probe_interval_ns = 1'000'000; // carriage returns while waiting for "? P" to be answered
   int start_attempts = 20;                   // carriage returns and queries at start-up
+  // After each command of a stop's spindle-off and drivers-off sequence: with no CTS handshake the
+  // host must give the chip time to take a command before the next (manual, chapter 16).
+  MonotonicNs command_settle_ns = 1'000'000;
   std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
   std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
   std::uint8_t spindle_output = 4;                            // general-purpose output (1 = on)
@@ -51,6 +75,8 @@ class Cy545Link final : public MachineLink {
   Cy545Link(SerialPort& port, Clock& clock, const Cy545Config& config);
 
   MachineResult start(MonotonicNs deadline_ns) override;
+  void abort_on(const std::atomic<bool>* flag) override { abort_ = flag; }
+  [[nodiscard]] MonotonicNs homing_bound_ns() const override;
   MachineResult home(MonotonicNs deadline_ns) override;
   MachineResult declare_home(MonotonicNs deadline_ns) override;
   MachineResult move(const MachineTarget& target, MonotonicNs deadline_ns) override;
@@ -61,6 +87,11 @@ class Cy545Link final : public MachineLink {
   MachineResult stop(MonotonicNs deadline_ns) override;
   [[nodiscard]] MachineStatus status() const override;
   [[nodiscard]] std::array<int, 3> home_approach() const override { return {1, 1, 1}; }
+
+  // What the last stop() achieved: the chip answered "? B" with the driver enable low after the
+  // spindle-off and drivers-off commands (true), or it could not be confirmed (false: the reason is
+  // in last_error(); cut the mill's power).
+  [[nodiscard]] bool outputs_confirmed_off() const { return outputs_confirmed_off_; }
 
   // For tests and the fault report: the last reply's bytes that did not parse, and why.
   [[nodiscard]] const char* last_error() const { return last_error_; }
@@ -80,7 +111,21 @@ class Cy545Link final : public MachineLink {
   // the deadline; a wrong position or no answer by the move's longest time is a fault.
   bool wait_free(MonotonicNs deadline_ns);
   bool write_bytes(std::string_view bytes, MonotonicNs deadline_ns);
+  // Spindle off, then bits 0-5 low (drivers off), then "? B" to confirm: whatever is latched, on the
+  // port directly (no fault is latched by it). False with last_error() saying what failed.
+  bool force_outputs_off(MonotonicNs deadline_ns);
+  // Sends "? B" and carriage returns until the chip answers (it can only answer once it is free):
+  // the user-bit levels it reports, or false by the deadline.
+  bool read_user_bits_when_free(std::uint8_t& levels, MonotonicNs deadline_ns);
   bool query(char letter, std::uint32_t& value, MonotonicNs deadline_ns);
+  enum class SwitchReading : std::uint8_t { Open, Closed, Bouncing, Failed };
+  // The selected home input read `reads` times: Open or Closed when all agree.
+  SwitchReading read_home_switch(std::size_t axis, MonotonicNs deadline_ns, int reads);
+  // One homing leg on the selected channel: `steps` (signed) at `rate`, then waits for the chip.
+  bool homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns);
+  bool home_axis(std::size_t axis, MonotonicNs deadline_ns);
+  [[nodiscard]] bool abort_asked() const { return abort_ != nullptr && abort_->load(std::memory_order_relaxed); }
+  MachineResult aborted(MonotonicNs deadline_ns);
 
   SerialPort& port_;
   Clock& clock_;
@@ -94,13 +139,16 @@ class Cy545Link final : public MachineLink {
   bool spindle_on_ = false;
   bool drivers_on_ = false;
   bool homed_ = false;
+  bool outputs_confirmed_off_ = false;
+  const std::atomic<bool>* abort_ = nullptr;
+  std::uint32_t rate_sent_ = 0;  // the R the chip holds (0: unknown)
   MonotonicNs busy_until_ns_ = 0;  // the running move's shortest end
   MonotonicNs busy_bound_ns_ = 0;  // its longest
   bool running_ = false;           // a move or seek was sent and not yet confirmed over
   std::uint64_t moves_done_ = 0;
   std::uint64_t bytes_sent_ = 0;
   std::uint64_t bytes_received_ = 0;
-  char last_error_[160] = {};
+  char last_error_[320] = {};
 };
 
 }  // namespace stencil::hal::cy545

@@ -3,6 +3,7 @@
 
 #include <fcntl.h>
 #include <poll.h>
+#include <sys/file.h>
 #include <sys/ioctl.h>
 #include <termios.h>
 #include <unistd.h>
@@ -30,6 +31,10 @@ SerialPort::~SerialPort() { close(); }
 
 void SerialPort::close() {
   if (fd_ >= 0) {
+    // The exclusive flag belongs to the tty, not to this descriptor: a port that stays open
+    // elsewhere (a pseudo-terminal's master, a program that opened it before us) would stay
+    // exclusive after we are gone. close() releases the flock.
+    ioctl(fd_, TIOCNXCL);
     ::close(fd_);
     fd_ = -1;
   }
@@ -38,6 +43,12 @@ void SerialPort::close() {
 bool SerialPort::open(const char* path, char (&error)[256]) {
   close();
   const int fd = ::open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0 && errno == EBUSY) {
+    // Another program holds the port with TIOCEXCL.
+    std::snprintf(error, sizeof error, "%s: the serial port is in use by another program (exclusive); stop it first",
+                  path);
+    return false;
+  }
   if (fd < 0) {
     std::snprintf(error, sizeof error, "%s: cannot open the serial port: %s", path, std::strerror(errno));
     return false;
@@ -47,10 +58,42 @@ bool SerialPort::open(const char* path, char (&error)[256]) {
     ::close(fd);
     return false;
   }
+  // Only one program may talk to the chip: a second rig would send `I` and reset the CY545 mid-job,
+  // a getty or a modem manager would write to it. The advisory lock refuses a second rig even as
+  // root (and any program that locks ports the same way); it is taken before TIOCEXCL so that a
+  // refused open never touches the holder's exclusive flag.
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    if (errno == EWOULDBLOCK) {
+      std::snprintf(error, sizeof error, "%s: the serial port is in use by another program (locked); stop it first",
+                    path);
+    } else {
+      std::snprintf(error, sizeof error, "%s: cannot lock the serial port: %s", path, std::strerror(errno));
+    }
+    ::close(fd);
+    return false;
+  }
+  // Root's open(2) goes through another program's TIOCEXCL: refuse that port too, and never clear
+  // the other program's flag (our close() would).
+  int exclusive = 0;
+  if (ioctl(fd, TIOCGEXCL, &exclusive) == 0 && exclusive != 0) {
+    std::snprintf(error, sizeof error, "%s: the serial port is in use by another program (exclusive); stop it first",
+                  path);
+    ::close(fd);
+    return false;
+  }
+  // TIOCEXCL makes every later open(2) of the port fail with EBUSY, except by root (CAP_SYS_ADMIN),
+  // whether or not the opener knows about locks.
+  if (ioctl(fd, TIOCEXCL) != 0) {
+    std::snprintf(error, sizeof error, "%s: cannot take the serial port exclusively: %s", path, std::strerror(errno));
+    ::close(fd);
+    return false;
+  }
+  // From here a failure must clear the exclusive flag it set (close() does both).
+  fd_ = fd;
   termios settings{};
   if (tcgetattr(fd, &settings) != 0) {
     std::snprintf(error, sizeof error, "%s: cannot read the port settings: %s", path, std::strerror(errno));
-    ::close(fd);
+    close();
     return false;
   }
   // A pseudo-terminal has no modem lines: TIOCMGET fails on it.
@@ -61,19 +104,21 @@ bool SerialPort::open(const char* path, char (&error)[256]) {
   cfsetospeed(&settings, B57600);
   settings.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | CSTOPB);
   settings.c_cflag |= CS8 | CREAD | CLOCAL;
-  if (modem_lines_) {
-    settings.c_cflag |= CRTSCTS;  // the chip drops CTS (its user bit 6) while busy
-  } else {
-    settings.c_cflag &= ~static_cast<tcflag_t>(CRTSCTS);
-  }
+  // No hang-up on close: with HUPCL the kernel drops DTR and RTS when the port closes, and the
+  // MMC-4S/CY545 must not see its modem lines drop when this program exits or restarts.
+  settings.c_cflag &= ~static_cast<tcflag_t>(HUPCL);
+  // No hardware flow control, modem lines or not: the CY545 drives CTS (its user bit 6) only once a
+  // Mode command enables it (manual, chapter 16), which the driver does not send, so the line's level
+  // says nothing and CRTSCTS could hold every byte or none. Without CTS the host must give the chip
+  // the time to take each command (chapter 16): the driver paces itself (Cy545Config).
+  settings.c_cflag &= ~static_cast<tcflag_t>(CRTSCTS);
   settings.c_cc[VMIN] = 1;  // with O_NONBLOCK: EAGAIN when nothing waits (VMIN 0 would read 0, like a hang-up)
   settings.c_cc[VTIME] = 0;
   if (tcsetattr(fd, TCSANOW, &settings) != 0) {
     std::snprintf(error, sizeof error, "%s: cannot set 57600 8N1 raw: %s", path, std::strerror(errno));
-    ::close(fd);
+    close();
     return false;
   }
-  fd_ = fd;
   return true;
 }
 

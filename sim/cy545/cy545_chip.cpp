@@ -41,7 +41,8 @@ void Cy545Chip::initialise_registers() {
   rate_ = kDefaultRateStepsPerSecond;
   first_rate_ = kDefaultRateStepsPerSecond;
   slope_ = 0;
-  mode_ = 0;
+  mode_ = kDefaultMode;  // the manual's power-up value: ASCII commands, serial query output
+  binary_ = Binary{};
   data_bus_ = 0;
   write_user_bits(0);
 }
@@ -90,6 +91,10 @@ void Cy545Chip::receive(std::uint8_t byte, hal::MonotonicNs now_ns) {
 }
 
 void Cy545Chip::parse_byte(std::uint8_t byte, hal::MonotonicNs at_ns) {
+  if ((mode_ & kModeAsciiBit) == 0) {
+    parse_binary_byte(byte, at_ns);
+    return;
+  }
   if (byte == kCarriageReturn) {
     execute_line(at_ns);
     line_.clear();
@@ -97,6 +102,37 @@ void Cy545Chip::parse_byte(std::uint8_t byte, hal::MonotonicNs at_ns) {
   }
   // Past the longest legal line the rest is not kept: the line is refused as too long anyway.
   if (line_.size() <= static_cast<std::size_t>(kMaxLineCharacters)) line_.push_back(static_cast<char>(byte));
+}
+
+// Binary mode reads bytes as letter, count, data whatever they are: ASCII text sent now is taken
+// apart this way, and a wrong count swallows the bytes after it (the manual: only a hardware reset
+// reliably resynchronises).
+void Cy545Chip::parse_binary_byte(std::uint8_t byte, hal::MonotonicNs at_ns) {
+  switch (binary_.stage) {
+    case Binary::Stage::letter:
+      binary_.letter = static_cast<char>(byte);
+      binary_.stage = Binary::Stage::count;
+      return;
+    case Binary::Stage::count:
+      binary_.count = byte;
+      binary_.received = 0;
+      binary_.stage = Binary::Stage::data;
+      break;
+    case Binary::Stage::data:
+      if (binary_.received < binary_.data.size()) binary_.data[binary_.received] = byte;
+      ++binary_.received;
+      break;
+  }
+  if (binary_.received < binary_.count) return;
+  binary_.stage = Binary::Stage::letter;
+  const ParseResult result = parse_binary_command(binary_.letter, binary_.data.data(), binary_.count);
+  if (result.status != ParseStatus::command) {
+    ++(result.status == ParseStatus::malformed ? counters_.malformed_lines : counters_.unsupported_commands);
+    last_error_ = Cy545LineError{std::string(1, binary_.letter), result.reason, result.column, result.status};
+    return;
+  }
+  ++counters_.commands_executed;
+  execute(result.command, at_ns);
 }
 
 void Cy545Chip::execute_line(hal::MonotonicNs at_ns) {

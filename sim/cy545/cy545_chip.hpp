@@ -79,6 +79,7 @@ class Cy545Chip {
 
  private:
   void parse_byte(std::uint8_t byte, hal::MonotonicNs at_ns);
+  void parse_binary_byte(std::uint8_t byte, hal::MonotonicNs at_ns);
   void execute_line(hal::MonotonicNs at_ns);
   void execute(const Cy545Command& command, hal::MonotonicNs at_ns);
   void apply_bit_command(std::uint32_t argument);
@@ -114,6 +115,16 @@ class Cy545Chip {
   std::array<std::uint8_t, 3> buffer_{};
   int buffered_ = 0;
   std::string line_;
+
+  // A command in the binary format (mode bit 7 clear): letter, count, then `count` data bytes (only
+  // the first three are kept: no command of the chip takes more).
+  struct Binary {
+    enum class Stage : std::uint8_t { letter, count, data } stage = Stage::letter;
+    char letter = 0;
+    std::size_t count = 0;
+    std::size_t received = 0;
+    std::array<std::uint8_t, 3> data{};
+  } binary_;
 
   // The executing command.
   struct Move {

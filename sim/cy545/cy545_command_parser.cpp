@@ -87,6 +87,43 @@ bool parse_number(std::string_view token, std::uint32_t& value) {
   return true;
 }
 
+ParseResult parse_binary_command(char letter, const std::uint8_t* data, std::size_t count) {
+  const CommandSpec* spec = find_spec(letter);
+  if (spec == nullptr) {
+    return refuse(kUnsupported.find(letter) != std::string_view::npos ? ParseStatus::unsupported : ParseStatus::malformed,
+                  "binary mode: not a command letter", 0);
+  }
+  std::size_t size = 0;
+  if (spec->arity == Arity::query) {
+    size = 1;
+  } else if (spec->arity == Arity::number) {
+    // The chip's own sizes (manual, chapter 4): pos24/num24 three bytes, del16 two, the rest one
+    // (R and F included: on the chip they are one byte, whatever the fake's ASCII R accepts).
+    size = spec->max > 0xFFFF ? 3 : letter == 'D' ? 2 : 1;
+  }
+  if (count != size) return refuse(ParseStatus::malformed, "binary mode: the data count is not this command's size", 1);
+  ParseResult result;
+  result.status = ParseStatus::command;
+  result.command.letter = letter;
+  if (spec->arity == Arity::query) {
+    if (kQueryable.find(static_cast<char>(data[0])) == std::string_view::npos) {
+      return refuse(ParseStatus::malformed, "binary mode: expected one of A P N R F S O B after '?'", 2);
+    }
+    result.command.query_letter = static_cast<char>(data[0]);
+    return result;
+  }
+  std::uint32_t value = 0;
+  for (std::size_t i = count; i > 0; --i) value = (value << 8U) | data[i - 1];
+  if (spec->arity == Arity::number && (value < spec->min || value > spec->max)) {
+    return refuse(ParseStatus::malformed, "binary mode: argument out of range", 2);
+  }
+  if ((letter == 'H' || letter == 'W') && !is_bit_level(value)) {
+    return refuse(ParseStatus::malformed, "binary mode: expected a bit 0-7 or 10H-17H", 2);
+  }
+  result.command.argument = value;
+  return result;
+}
+
 ParseResult parse_command_line(std::string_view line) {
   if (line.empty()) {
     ParseResult result;

@@ -1,6 +1,7 @@
 // Parsing one CY545 ASCII command line (without its CR) into a command, or the reason it is refused.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <string_view>
 
@@ -29,6 +30,12 @@ struct ParseResult {
 
 // Allocation-free; `line` excludes the terminating CR.
 ParseResult parse_command_line(std::string_view line);
+
+// One command in the binary format (mode register bit 7 clear): its letter and the `count` data
+// bytes that followed the count byte, least significant first. The count must be the command's own
+// size (0 for G I + -, 1 for a byte argument or the queried letter, 2 for D, 3 for A N P); anything
+// else is malformed, as is a letter the chip has not.
+ParseResult parse_binary_command(char letter, const std::uint8_t* data, std::size_t count);
 
 // A number in the chip's syntax: decimal digits, or hex digits with an H suffix and a leading decimal
 // digit. False when malformed or above 0xFFFFFFFF.

@@ -61,10 +61,17 @@
 //            until it matches; stop and set the position register to 0. Steps at the first rate F, one
 //            every 1/F s, no ramp. Gives up (position unchanged) after 16777215 steps in one phase.
 //  W bit     wait until the bit matches (same coding as H). Busy meanwhile.
-//  I         initialise: position 0, N 0, direction +, R and F back to 1000 steps/s, S 0, mode 0, user
+//  I         initialise: position 0, N 0, direction +, R and F back to 1000 steps/s, S 0, mode 80H, user
 //            bits 0-5 and 7 cleared (drivers disabled). The MMC-4S latches (channel, outputs) keep
 //            their state: they are on the board, not in the chip.
-//  O mode    mode register 0..255: stored and reported, no effect.
+//  O mode    mode register 0..255 (manual, chapter 9 "Operating Mode Command"): power-up and I leave
+//            it 80H, ASCII commands with standard serial query output. Bit 7 selects the command
+//            format: set = ASCII, CLEAR = BINARY (chapter 4 "Binary Command Format": the letter, a
+//            binary count of data bytes, the data least significant byte first). After "O 0" the fake
+//            parses every following byte in that format, as the chip does: an ASCII "? P\r" is the
+//            letter '?' with a count of 32 (the space) and swallows the next 32 bytes; only a reset
+//            (power-up) or a well-formed binary "O" with bit 7 set brings ASCII back. Other bits:
+//            stored and reported, no effect (MB4, position display while homing, is not modelled).
 //  D del16   delay 0..65535 ms (busy meanwhile).
 //  ? L       query: L is one of A P N R F S O B. Reply: L, '=', the value in decimal without leading
 //            zeros, CR. A and P both report the position register (24-bit, 0..16777215), N the step
@@ -122,6 +129,8 @@ inline constexpr int kMaxLineCharacters = 32;
 inline constexpr std::uint32_t kMax24Bit = 0xFFFFFF;
 inline constexpr std::uint32_t kMaxRateStepsPerSecond = 27000;
 inline constexpr std::uint32_t kDefaultRateStepsPerSecond = 1000;
+inline constexpr std::uint32_t kDefaultMode = 0x80;      // ASCII commands, standard serial output
+inline constexpr std::uint32_t kModeAsciiBit = 0x80;
 
 // User bits.
 inline constexpr int kBitDriverEnable = 0;

@@ -35,8 +35,10 @@ constexpr MonotonicNs kMs = 1'000'000;
 
 Cy545Config fast_homing_config() {
   Cy545Config config;
-  config.homing_rate = 20000;        // the fake seeks at F: quick in tests
+  config.homing_rate = 20000;        // quick in tests
+  config.homing_slow_rate = 5000;
   config.homing_travel_steps = 2000;  // the test puts every axis within 200 steps of its switch
+  config.reply_timeout_ns = 250 * kMs;  // the fake is a thread on a host that is not real-time
   return config;
 }
 
@@ -75,7 +77,7 @@ struct Bench {
   void start_and_home() {
     const MachineResult started = link.start(in(2000 * kMs));
     CHECK_TEXT(started.done, link.last_error());
-    const MachineResult homed = link.home(in(5000 * kMs));
+    const MachineResult homed = link.home(in(link.homing_bound_ns() + 1000 * kMs));
     CHECK_TEXT(homed.done, link.last_error());
   }
 };
@@ -261,11 +263,20 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
       const std::lock_guard<std::mutex> lock(recorded_mutex);
       recorded.append(buffer, static_cast<std::size_t>(n));
       stream.append(buffer, static_cast<std::size_t>(n));
-      const std::size_t query = stream.find("? P\r", seen);
-      if (query != std::string::npos && answered < 5) {
-        seen = query + 4;
-        CHECK(write(master, replies[answered], std::strlen(replies[answered])) > 0);
-        ++answered;
+      // "? B" (the outputs, read back after the drivers-off commands) reads all low but CTS.
+      for (;;) {
+        const std::size_t position_query = stream.find("? P\r", seen);
+        const std::size_t bits_query = stream.find("? B\r", seen);
+        if (bits_query < position_query) {
+          seen = bits_query + 4;
+          CHECK(write(master, "B=64\r", 5) > 0);
+        } else if (position_query != std::string::npos && answered < 5) {
+          seen = position_query + 4;
+          CHECK(write(master, replies[answered], std::strlen(replies[answered])) > 0);
+          ++answered;
+        } else {
+          break;
+        }
       }
     }
   });
@@ -286,7 +297,9 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
   const MachineResult started = link.start(clock.now_ns() + 1000 * kMs);
   CHECK_TEXT(started.done, link.last_error());
   CHECK(link.declare_home(clock.now_ns() + 100 * kMs).done);
-  STRCMP_EQUAL("\r? P\rI\rR 1000\rF 1000\rS 0\rO 0\rA 0\r", take().c_str());
+  // Wake, initialise in ASCII mode, then the outputs off (spindle output 4 with the drivers off,
+  // strobed; every bit low) and read back, then home declared.
+  STRCMP_EQUAL("\r? P\rI\rO 128\rR 1000\rF 1000\rS 0\r? B\rB 50H\rB 7H\r/B 7\rB 40H\r? B\rA 0\r", take().c_str());
   MachineResult moved = link.move(target(5, -3, 2, {2, 0, 1}, false), clock.now_ns() + 500 * kMs);
   CHECK_TEXT(moved.done, link.last_error());
   STRCMP_EQUAL(
@@ -320,4 +333,63 @@ TEST(Cy545Link, MeasuresTheLinksThroughputAgainstTheFake) {
   std::printf("\n  CY545 link against the fake: %.1f updates/s, %.1f bytes per update (3 axes, 33 steps)\n",
               updates / seconds, bytes_per_update);
   CHECK(bench.link.verify(bench.in(200 * kMs)).done);
+}
+
+// Issue 18, item 2: "O 0" put the real chip into binary mode; the driver now says ASCII explicitly.
+TEST(Cy545Link, StartLeavesTheChipInAsciiMode) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK_EQUAL(0x80U, bench.runner.with_fake([](sim::cy545::FakeCy545& fake) { return fake.chip().mode(); }));
+}
+
+// Issue 18, item 1: the MMC-4S's latches keep the spindle on across a program's restart (and the
+// chip's "I"): the next start must turn it off before anything else.
+TEST(Cy545Link, StartTurnsOffASpindleThatAnEarlierRunLeftOn) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  // The program dies here (no stop); a new one opens the same port.
+  Cy545Link restarted(bench.port, bench.clock, fast_homing_config());
+  CHECK_TEXT(restarted.start(bench.in(2000 * kMs)).done, restarted.last_error());
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.spindle_on(); }));
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.drivers_enabled(); }));
+  CHECK_FALSE(restarted.status().spindle_on);
+}
+
+// Issue 18, item 1: a latched fault (here a garbled reply) used to make stop() refuse before it sent
+// anything, leaving the spindle turning while the terminal said the mill was stopped.
+TEST(Cy545Link, StopTurnsSpindleAndDriversOffEvenWithAFaultLatched) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_replies_garbled(true);
+    return 0;
+  });
+  CHECK(bench.link.verify(bench.in(500 * kMs)).fault == MachineFault::GarbledReply);
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.set_replies_garbled(false);  // the line recovers; the latch stays
+    return 0;
+  });
+  const MachineResult stopped = bench.link.stop(bench.in(2000 * kMs));
+  CHECK_TEXT(stopped.done, bench.link.last_error());
+  CHECK(bench.link.outputs_confirmed_off());
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.spindle_on(); }));
+  CHECK_FALSE(bench.runner.with_fake([&](sim::cy545::FakeCy545&) { return bench.mill.drivers_enabled(); }));
+  CHECK(bench.link.status().fault == MachineFault::GarbledReply);  // the reason stays reported
+}
+
+// Issue 18, item 1: a stop that cannot reach the chip says so, instead of claiming the mill stopped.
+TEST(Cy545Link, AStopThatCannotReachTheControllerSaysTheSpindleMayStillBeOn) {
+  Bench bench;
+  bench.start_and_home();
+  CHECK(bench.link.set_spindle(true, bench.in(200 * kMs)).done);
+  bench.runner.with_fake([](sim::cy545::FakeCy545& fake) {
+    fake.close_pty();
+    return 0;
+  });
+  const MachineResult stopped = bench.link.stop(bench.in(500 * kMs));
+  CHECK_FALSE(stopped.done);
+  CHECK_FALSE(bench.link.outputs_confirmed_off());
+  STRCMP_CONTAINS("may still be on", bench.link.last_error());
 }

@@ -42,9 +42,40 @@ TEST(FakeCy545, QueryRepliesAreTheLetterEqualsDecimalDigitsAndCarriageReturn) {
   STRCMP_EQUAL("R=1000\r", bench.query("? R\r").c_str());
   STRCMP_EQUAL("F=1000\r", bench.query("? F\r").c_str());
   STRCMP_EQUAL("S=0\r", bench.query("? S\r").c_str());
-  STRCMP_EQUAL("O=0\r", bench.query("? O\r").c_str());
+  STRCMP_EQUAL("O=128\r", bench.query("? O\r").c_str());  // the manual's power-up mode: ASCII
   STRCMP_EQUAL("B=64\r", bench.query("? B\r").c_str());  // only CTS (bit 6): ready
   LONGS_EQUAL(8, bench.fake.chip().counters().replies);
+}
+
+// Issue 18, item 2: the driver sent "O 0" at start-up, which clears the mode register's bit 7 and
+// puts the real chip into binary command mode (manual, chapter 9): every ASCII command after it is
+// read as a binary letter, count and data, and no query is answered.
+TEST(FakeCy545, ModeZeroPutsTheChipInBinaryModeWhereAsciiCommandsAreNotUnderstood) {
+  CHECK_TRUE(bench.send("\r"));
+  CHECK_TRUE(bench.send("O 0\r"));
+  LONGS_EQUAL(0, static_cast<long>(bench.fake.chip().mode()));
+  // "? P\r" in binary is '?' with a data count of 32 (the space): it waits for 32 more bytes.
+  STRCMP_EQUAL("", bench.query("? P\r").c_str());
+  CHECK_TRUE(bench.send("N 5\r"));
+  LONGS_EQUAL(0, static_cast<long>(bench.fake.chip().step_count()));
+  LONGS_EQUAL(0, bench.fake.chip().counters().replies);
+}
+
+TEST(FakeCy545, BinaryCommandsTakeLetterCountAndLittleEndianDataAndModeBit7BringsAsciiBack) {
+  CHECK_TRUE(bench.send("\r"));
+  CHECK_TRUE(bench.send("O 0\r"));
+  CHECK_TRUE(bench.send(std::string("N\x03\x11\x22\x33", 5)));  // N 332211H
+  LONGS_EQUAL(0x332211, static_cast<long>(bench.fake.chip().step_count()));
+  CHECK_TRUE(bench.send(std::string("R\x02\x01\x02", 4)));  // a wrong count: refused, counted
+  LONGS_EQUAL(1, bench.fake.chip().counters().malformed_lines);
+  CHECK_TRUE(bench.send(std::string("O\x01\x80", 3)));  // back to ASCII
+  STRCMP_EQUAL("N=3351057\r", bench.query("? N\r").c_str());
+}
+
+TEST(FakeCy545, InitialiseRestoresTheAsciiMode) {
+  CHECK_TRUE(bench.send("\r"));
+  CHECK_TRUE(bench.send("O 81H\r"));
+  STRCMP_EQUAL("O=128\r", bench.query("I\r? O\r").c_str());
 }
 
 TEST(FakeCy545, DecimalAndHexArgumentsSetTheSameValue) {
@@ -243,7 +274,7 @@ TEST(FakeCy545, DelayIsBusyForItsMilliseconds) {
 
 TEST(FakeCy545, InitialiseResetsRegistersAndUserBitsButNotTheBoardLatches) {
   CHECK_TRUE(bench.start_on_channel(1));
-  CHECK_TRUE(bench.send("A 99\rN 5\r-\rR 300\rF 200\rS 9\rO 3\rI\r"));
+  CHECK_TRUE(bench.send("A 99\rN 5\r-\rR 300\rF 200\rS 9\rO 83H\rI\r"));
   const Cy545Chip& chip = bench.fake.chip();
   UNSIGNED_LONGS_EQUAL(0, chip.position_register());
   UNSIGNED_LONGS_EQUAL(0, chip.step_count());
@@ -251,7 +282,7 @@ TEST(FakeCy545, InitialiseResetsRegistersAndUserBitsButNotTheBoardLatches) {
   UNSIGNED_LONGS_EQUAL(1000, chip.rate());
   UNSIGNED_LONGS_EQUAL(1000, chip.first_rate());
   UNSIGNED_LONGS_EQUAL(0, chip.slope());
-  UNSIGNED_LONGS_EQUAL(0, chip.mode());
+  UNSIGNED_LONGS_EQUAL(0x80, chip.mode());  // ASCII, as after power-up
   UNSIGNED_LONGS_EQUAL(0, chip.user_bit_latches());
   CHECK_FALSE(bench.mill.drivers_enabled());
   CHECK_EQUAL(1, bench.fake.board().selected_channel().value_or(-1));
@@ -262,7 +293,7 @@ TEST(FakeCy545, RateFirstRateSlopeAndModeAreStoredAndQueried) {
   STRCMP_EQUAL("R=900\r", bench.query("R 900\r? R\r").c_str());
   STRCMP_EQUAL("F=200\r", bench.query("F 0C8H\r? F\r").c_str());
   STRCMP_EQUAL("S=200\r", bench.query("S 200\r? S\r").c_str());
-  STRCMP_EQUAL("O=5\r", bench.query("O 5\r? O\r").c_str());
+  STRCMP_EQUAL("O=133\r", bench.query("O 85H\r? O\r").c_str());  // bit 7 kept: still ASCII
 }
 
 TEST(FakeCy545, SlopeRampsFromTheFirstRateAndLengthensTheMove) {
