@@ -101,6 +101,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
     result.touched_rebuilt = static_cast<std::uint32_t>(controller->touched().count());
   }
   hal::Clock& clock = *job.machine_clock;
+  // A stop asked for while the mill wakes or homes is taken between two of its commands, not after.
+  job.machine->abort_on(job.interrupted);
   // Wake-up and spindle in seconds; homing as long as the link says it can take from anywhere.
   if (!machine->start(clock.now_ns() + job.machine->homing_bound_ns() + 20'000'000'000)) {
     result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
@@ -115,9 +117,16 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   std::atomic<bool> stop_asked{false};
   std::thread machine_thread([&] {
     hal::MonotonicNs next = clock.now_ns();
+    bool stop_reported = false;
     while (!stop.load()) {
       clock.sleep_until_ns(next);
       machine->update(next + 2 * kUpdateNs);
+      if (job.progress && !stop_reported && machine->state() == control::MachineSideState::Stopped) {
+        stop_reported = true;
+        job.progress(machine->stop_confirmed()
+                         ? "the mill is stopped: spindle and drivers off, confirmed by the controller"
+                         : "WARNING: the mill's spindle and drivers could NOT be confirmed off: switch the mill's power off");
+      }
       if (job.display != nullptr && model.ready()) {
         job.display->on_machine(machine->statistics().last_lag_mm, model);
       }
@@ -140,8 +149,8 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
           job.progress(frame.safe_reason == control::SafeReason::None
                            ? std::string("force restored; the mill stays stopped (re-homing to resume the cut is not built yet)")
                            : std::string("SAFE STATE: ") + control::safe_reason_name(frame.safe_reason) +
-                                 ": no force, the mill held and stopped. Hold the handle still near the tool and type "
-                                 "'reset' to feel the part again; Ctrl-C ends the run");
+                                 ": no force; the mill is being held and stopped. Hold the handle still near the tool "
+                                 "and type 'reset' to feel the part again; Ctrl-C ends the run");
         }
         if (job.progress && frame.reset_requests != last.reset_requests && frame.last_reset != control::ResetOutcome::Accepted) {
           job.progress(std::string("reset refused: ") + control::reset_outcome_name(frame.last_reset));
@@ -207,6 +216,7 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   // The runner refused before the cycle ran (or the cycle never reached the machine side): the
   // machine is stopped here all the same.
   machine->shut_down(clock.now_ns() + 2 * kUpdateNs);
+  result.machine_stop_confirmed = machine->stop_confirmed();
   if (!ran) {
     result.error = runner_error;
   }

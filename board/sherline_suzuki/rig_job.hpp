@@ -54,7 +54,8 @@ struct RigJob {
   // of the machined stock are rebuilt from it before the machine homes again.
   std::string resume_from;
   std::size_t resume_bytes = 0;
-  const std::atomic<bool>* interrupted = nullptr;  // SIGINT/SIGTERM: a stop command to the cycle
+  // SIGINT, SIGTERM, SIGHUP, SIGQUIT: a stop command to the cycle, and homing given up between commands.
+  const std::atomic<bool>* interrupted = nullptr;
   double duration_s = 0.0;                          // 0: until interrupted or a safe state
   // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
   // hosts they run on are not real-time hosts (make latency measures what a host gives).
@@ -78,6 +79,7 @@ struct RigResult {
   double compute_p99_us = 0.0, compute_max_us = 0.0;
   double max_force_n = 0.0, max_offset_mm = 0.0;
   std::uint64_t machine_updates = 0;
+  bool machine_stop_confirmed = false;  // the link confirmed spindle and drivers off at the end
   double machine_max_lag_mm = 0.0;
   double model_removed_mm3 = 0.0;
   double run_s = 0.0;

@@ -1,7 +1,7 @@
 // stencil-rig: the controller on the real rig (board sherline_suzuki): the haptic device over the
 // PIO shared-memory card or SocketCAN, the mill's CY545 over RS-232. It starts by checking
 // everything it can (the host's real-time readiness, the tables, the serial port, the haptic link)
-// and says plainly what is missing, then homes the mill and runs the cycle until SIGINT/SIGTERM,
+// and says plainly what is missing, then homes the mill and runs the cycle until SIGINT, SIGTERM, SIGHUP or SIGQUIT,
 // --duration or a safe state, and stops the machine on the way out.
 #include <poll.h>
 #include <signal.h>
@@ -121,7 +121,7 @@ int main(int argc, char** argv) {
   CLI::App app{
       "stencil-rig: the haptic stencil controller on the Sherline + Suzuki rig. Checks the host's real-time\n"
       "readiness, loads the tables, opens the CY545's serial port and the haptic device's link, and says what\n"
-      "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM or --duration, and holds\n"
+      "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM/SIGHUP/SIGQUIT or --duration, and holds\n"
       "and stops the mill on the way out. In a fault's safe state (no force, the mill held and\n"
       "stopped) type 'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
       "stopped (re-homing to resume the cut is not built yet).\n"
@@ -168,7 +168,7 @@ int main(int argc, char** argv) {
                  "from it, the mill homes again (Z first, out of the stock) and the cut carries on from wherever the "
                  "operator takes the handle; the journal carries on in the same file and the report covers the whole job");
   double duration_s = 0.0;
-  app.add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT/SIGTERM)")
+  app.add_option("--duration", duration_s, "stop after this many seconds (default: until SIGINT, SIGTERM, SIGHUP or SIGQUIT)")
       ->check(CLI::NonNegativeNumber);
   app::DisplayOptions display_options;
   app::add_display_options(app, display_options);
@@ -341,10 +341,14 @@ int main(int argc, char** argv) {
   hal::posix_clock::MonotonicClock clock;
   hal::cy545::Cy545Config link_config;
   hal::cy545::Cy545Link link(port, clock, link_config);
+  // Every signal that ends a session ends the job through the cycle's stop (spindle and drivers off):
+  // a closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) as much as Ctrl-C. Nothing survives SIGKILL or a
+  // power cut: the next start turns the outputs off first, and the rig needs its hardware watchdog.
   struct sigaction action {};
   action.sa_handler = on_signal;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+    sigaction(signal_number, &action, nullptr);
+  }
   if (cpu >= 0 && !app::keep_off_cpu(cpu)) {
     std::fprintf(stderr, "stencil-rig: the other threads could not be kept off CPU %d\n", cpu);
   }
@@ -379,7 +383,7 @@ int main(int argc, char** argv) {
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
   TerminalCommands terminal;
   job.reset_requested = [&terminal] { return terminal.reset_typed(); };
-  std::printf("stencil-rig: homing the mill, then cutting; SIGINT (Ctrl-C) stops\n");
+  std::printf("stencil-rig: homing the mill, then cutting; Ctrl-C stops (homing too)\n");
   std::fflush(stdout);
   const app::RealtimeOptions options{priority, cpu, require_rt};
   const board::sherline_suzuki::RigResult result = board::sherline_suzuki::run_rig(
@@ -420,6 +424,10 @@ int main(int argc, char** argv) {
   if (!result.error.empty()) {
     std::fprintf(stderr, "stencil-rig: %s\n", result.error.c_str());
   }
+  if (!result.machine_stop_confirmed) {
+    std::fprintf(stderr, "stencil-rig: WARNING: the mill's spindle and drivers could not be confirmed off (%s): switch the "
+                 "mill's power off\n", link.last_error());
+  }
   if (!journal_closed) {
     std::fprintf(stderr, "stencil-rig: %s\n", journal_writer.error().c_str());
   }
@@ -432,7 +440,8 @@ int main(int argc, char** argv) {
         {"compute_us", {{"p99", result.compute_p99_us}, {"max", result.compute_max_us}}},
         {"max_force_n", result.max_force_n},
         {"max_offset_mm", result.max_offset_mm},
-        {"machine", {{"updates", result.machine_updates}, {"max_lag_mm", result.machine_max_lag_mm}}},
+        {"machine", {{"updates", result.machine_updates}, {"max_lag_mm", result.machine_max_lag_mm},
+                     {"stop_confirmed", result.machine_stop_confirmed}}},
         {"stock_model", {{"removed_volume_mm3", result.model_removed_mm3}}},
         {"safe_state", reason},
         {"first_fault", result.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)
@@ -451,6 +460,6 @@ int main(int argc, char** argv) {
     }
   }
   const bool asked = result.safe_state == control::SafeReason::Stopped && result.first_fault == control::SafeReason::None &&
-                     result.error.empty() && journal_closed;
+                     result.error.empty() && journal_closed && result.machine_stop_confirmed;
   return asked ? 0 : kExitNotStarted;
 }

@@ -38,7 +38,7 @@ constexpr int kExitDone = 0;
 constexpr int kExitBadInput = 2;
 constexpr int kExitSafeState = 3;
 
-// Set by SIGINT and SIGTERM: the run ends through the cycle's safe state (a stop command).
+// Set by SIGINT, SIGTERM, SIGHUP and SIGQUIT: the run ends through the cycle's safe state (a stop command).
 std::atomic<bool> interrupted{false};
 
 void on_signal(int) { interrupted.store(true); }
@@ -161,8 +161,9 @@ int main(int argc, char** argv) {
   // stop, with its report and journal, once it runs.
   struct sigaction action {};
   action.sa_handler = on_signal;
-  sigaction(SIGINT, &action, nullptr);
-  sigaction(SIGTERM, &action, nullptr);
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {  // as stencil-rig: a closed terminal too
+    sigaction(signal_number, &action, nullptr);
+  }
   CLI::App app{
       "stencil-sim: the haptic stencil controller's cycle and machine side against a simulated operator and\n"
       "device, the fake CY545 stepper controller on a pseudo-terminal and a simulated mill that removes\n"

@@ -86,7 +86,7 @@ struct MachineHandoff {
 // From the machine side, when something happens there.
 enum class MachineEventKind : std::uint8_t {
   Fault,    // the link latched a fault: the cycle enters the safe state
-  Stopped,  // the machine is stopped (after a safe state): for the record
+  Stopped,  // the machine is stopped (after a safe state): for the record; fault 1: not confirmed off
   JournalFailed,  // a target could not be recorded, so it was not sent: the cycle enters the safe state
   Backlog,        // how much of the path the mill has still to follow (each update): the cycle slows the tool
 };

@@ -36,8 +36,9 @@ void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineE
   }
   state_ = MachineSideState::Stopped;
   link_.hold();
-  static_cast<void>(link_.stop(deadline_ns));  // a link already in fault is stopped as far as it can be
-  static_cast<void>(to_cycle_.push({MachineEventKind::Stopped, 0}));
+  // The link tries whatever fault it has latched, and says whether the outputs are confirmed off.
+  stop_confirmed_ = link_.stop(deadline_ns).done;
+  static_cast<void>(to_cycle_.push({MachineEventKind::Stopped, static_cast<std::uint8_t>(stop_confirmed_ ? 0 : 1)}));
 }
 
 void MachineSide::update(hal::MonotonicNs update_deadline_ns) {

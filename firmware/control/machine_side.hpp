@@ -71,6 +71,9 @@ class MachineSide {
   // More updates than this in a row with no legal staircase (3 s at 30 Hz) is a fault: stalled().
   static constexpr int kMaxBlockedUpdates = 90;
   [[nodiscard]] bool stalled() const { return stalled_; }
+  // After a stop: whether the link confirmed the spindle and drivers off (false: they may still be
+  // on, whatever the cycle's safe state says; the operator must cut the mill's power).
+  [[nodiscard]] bool stop_confirmed() const { return stop_confirmed_; }
   // Where the last target sent puts the tool tip (world mm): home until the first.
   [[nodiscard]] const Eigen::Vector3d& commanded_tip_mm() const { return commanded_tip_mm_; }
 
@@ -91,6 +94,7 @@ class MachineSide {
   bool record_failed_ = false;
   int blocked_in_a_row_ = 0;
   bool stalled_ = false;
+  bool stop_confirmed_ = false;
   Eigen::Vector3d commanded_tip_mm_;
 };
 

@@ -45,7 +45,18 @@ std::optional<Axis> Mmc4sBoard::axis_of_channel(int channel) const {
 
 bool Mmc4sBoard::input_level(int port) const {
   for (int axis = 0; axis < rig::kAxisCount; ++axis) {
-    if (rig::kMmc4s.home_sensor_input[axis] == port) return mill_.home_switch_closed(static_cast<Axis>(axis));
+    if (rig::kMmc4s.home_sensor_input[axis] != port) continue;
+    const auto a = static_cast<Axis>(axis);
+    bool closed = mill_.home_switch_closed(a);
+    const std::int64_t from_edge =
+        mill_.axis_position_steps(a) - mill_.config().axes[static_cast<std::size_t>(axis)].home_switch_edge_steps;
+    if (bounce_band_steps_ > 0 && from_edge >= -bounce_band_steps_ && from_edge < bounce_band_steps_) {
+      bounce_state_ ^= bounce_state_ << 13U;
+      bounce_state_ ^= bounce_state_ >> 17U;
+      bounce_state_ ^= bounce_state_ << 5U;
+      closed = (bounce_state_ & 1U) != 0;
+    }
+    return closed != home_inverted_;
   }
   if (port >= kMotorChannels && port < kMuxPorts) return general_inputs_[static_cast<std::size_t>(port)];
   return false;

@@ -27,6 +27,13 @@ class Mmc4sBoard {
   [[nodiscard]] bool general_output(int port) const;
   void set_general_input(int port, bool level);
 
+  // The home switches as a real rig wires them. Inverted: the inputs read 0 while a switch is closed
+  // (normally-closed contacts, or a pull-down), so a driver assuming the opposite seeks the wrong way.
+  // Bounce: within `band_steps` of a switch's edge its contacts chatter, and each read is a coin
+  // toss (a fixed sequence: deterministic runs); 0 is a perfect switch.
+  void set_home_switches_inverted(bool inverted) { home_inverted_ = inverted; }
+  void set_home_switch_bounce(std::int64_t band_steps) { bounce_band_steps_ = band_steps; }
+
   [[nodiscard]] std::int64_t steps_to_no_channel() const { return steps_to_no_channel_; }
   [[nodiscard]] std::int64_t channel_selections() const { return channel_selections_; }
 
@@ -40,6 +47,9 @@ class Mmc4sBoard {
   std::optional<int> selected_channel_;
   std::array<bool, 8> outputs_{};         // general-purpose outputs 4..7 (0..3 unused)
   std::array<bool, 8> general_inputs_{};  // general-purpose inputs 4..7
+  bool home_inverted_ = false;
+  std::int64_t bounce_band_steps_ = 0;
+  mutable std::uint32_t bounce_state_ = 0x9E3779B9U;  // xorshift32: reads near an edge advance it
   std::int64_t steps_to_no_channel_ = 0;
   std::int64_t channel_selections_ = 0;
 };

@@ -58,11 +58,12 @@ TEST(MillChain, TheMillFollowsTheVirtualToolRoundTheHexPrismThroughTheRealDriver
   CHECK_TEXT(port.open(fake.slave_path().c_str(), error), error);
   hal::cy545::Cy545Config config;
   config.homing_rate = 20000;
+  config.homing_slow_rate = 5000;
   config.homing_travel_steps = 2000;
   hal::cy545::Cy545Link link(port, clock, config);
   sim::cy545::FakeCy545Runner runner{fake};
   CHECK_TEXT(link.start(clock.now_ns() + 2000 * kMs).done, link.last_error());
-  CHECK_TEXT(link.home(clock.now_ns() + 5000 * kMs).done, link.last_error());
+  CHECK_TEXT(link.home(clock.now_ns() + link.homing_bound_ns() + 1000 * kMs).done, link.last_error());
   CHECK(link.set_spindle(true, clock.now_ns() + 200 * kMs).done);
   const std::array<std::int64_t, 3> axis_at_home = runner.with_fake([&](sim::cy545::FakeCy545&) {
     return std::array<std::int64_t, 3>{mill.axis_position_steps(Axis::x), mill.axis_position_steps(Axis::y),

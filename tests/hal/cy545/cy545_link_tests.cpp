@@ -17,6 +17,7 @@
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"
+#include "sim/cy545/fake_cy545_clock.hpp"
 #include "sim/cy545/fake_cy545_runner.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
@@ -392,4 +393,111 @@ TEST(Cy545Link, AStopThatCannotReachTheControllerSaysTheSpindleMayStillBeOn) {
   CHECK_FALSE(stopped.done);
   CHECK_FALSE(bench.link.outputs_confirmed_off());
   STRCMP_CONTAINS("may still be on", bench.link.last_error());
+}
+
+namespace {
+
+// The same chain on virtual time (the fast simulation's FakeCy545Clock): deterministic, and a
+// homing of tens of seconds takes a fraction of one here.
+struct VirtualBench {
+  sim::SimulatedMill mill{sim::sherline_mill_config()};  // every axis mid-travel, as at power-up
+  sim::cy545::FakeCy545 fake{mill, 0};
+  sim::cy545::FakeCy545Clock clock{fake, 0, 57600.0};
+  SerialPort port;
+  bool opened = Bench::open(port, fake.slave_path());
+  Cy545Link link;
+
+  explicit VirtualBench(const Cy545Config& config = Cy545Config{}) : link(port, clock, config) {}
+
+  // As the rig does: wake-up and spindle in seconds, homing as long as the link says it can take.
+  MachineResult start_and_home() {
+    const MachineResult started = link.start(clock.now_ns() + 20'000 * kMs);
+    if (!started.done) {
+      return started;
+    }
+    return link.home(clock.now_ns() + link.homing_bound_ns() + 20'000 * kMs);
+  }
+};
+
+}  // namespace
+
+// Issue 18, item 3: with the shipped defaults the old home() needed three seeks of 41 s plus margins
+// (123.1 s) within the rig's 120 s and always refused; now the deadline follows the travel.
+TEST(Cy545Link, ShippedDefaultsHomeFromPowerUpWithinTheDeadlineTheRigGives) {
+  VirtualBench bench;
+  const MonotonicNs began = bench.clock.now_ns();
+  const MachineResult homed = bench.start_and_home();
+  CHECK_TEXT(homed.done, bench.link.last_error());
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::x));
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::y));
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::z));
+  std::printf("\n  homing from mid-travel with the shipped defaults: %.1f s (bound %.0f s)\n",
+              static_cast<double>(bench.clock.now_ns() - began) / 1e9,
+              static_cast<double>(bench.link.homing_bound_ns()) / 1e9);
+}
+
+// Issue 18, item 3: inverted switch wiring made the chip's H command seek the wrong way (Z down into
+// the work, on and on). Now a switch that still reads closed a zone's depth out is a fault, and the
+// axis has moved no further than that.
+TEST(Cy545Link, InvertedHomeSwitchWiringIsAFaultAfterAtMostTheSwitchZone) {
+  VirtualBench bench;
+  bench.fake.board().set_home_switches_inverted(true);
+  const std::int64_t z_before = bench.mill.axis_position_steps(Axis::z);
+  const MachineResult homed = bench.start_and_home();
+  CHECK_FALSE(homed.done);
+  CHECK(homed.fault == MachineFault::PositionMismatch);
+  STRCMP_CONTAINS("homing axis Z: its home switch still reads closed", bench.link.last_error());
+  const Cy545Config defaults;
+  CHECK(bench.mill.axis_position_steps(Axis::z) - z_before <= defaults.home_switch_zone_steps + defaults.homing_chunk_steps);
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::x) - sim::sherline_mill_config().axes[0].initial_position_steps);
+}
+
+TEST(Cy545Link, TheConfiguredClosedLevelHomesInvertedWiring) {
+  Cy545Config config;
+  config.home_switch_closed_level = {false, false, false};
+  VirtualBench bench(config);
+  bench.fake.board().set_home_switches_inverted(true);
+  CHECK_TEXT(bench.start_and_home().done, bench.link.last_error());
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::z));
+}
+
+// Issue 18, item 9: a switch that chatters near its edge. The slow, debounced departure finds the
+// edge within the chatter's band; that band is the repeatability of home, and so of --resume.
+TEST(Cy545Link, ABouncingHomeSwitchHomesWithinItsBandAndTheSpreadIsReported) {
+  constexpr std::int64_t kBand = 6;  // steps either side of the edge (about 10 um)
+  std::int64_t lowest = 1 << 20, highest = -(1 << 20);
+  for (int run = 0; run < 8; ++run) {
+    VirtualBench bench;
+    bench.fake.board().set_home_switch_bounce(kBand);
+    for (int skip = 0; skip < run * 7; ++skip) {  // another stretch of the chatter's sequence each run
+      static_cast<void>(bench.fake.board().input_level(2));
+    }
+    bench.mill.place_axis(Axis::z, 300 + 37 * run, sim::StepDirection::positive);
+    CHECK_TEXT(bench.start_and_home().done, bench.link.last_error());
+    const std::int64_t z = bench.mill.axis_position_steps(Axis::z);
+    lowest = std::min(lowest, z);
+    highest = std::max(highest, z);
+  }
+  CHECK(lowest >= -kBand && highest <= kBand);
+  std::printf("\n  home with a switch chattering +-%lld steps: Z homed within [%lld, %lld] steps of the edge, a spread of %lld "
+              "steps (%.1f um)\n",
+              static_cast<long long>(kBand), static_cast<long long>(lowest), static_cast<long long>(highest),
+              static_cast<long long>(highest - lowest), static_cast<double>(highest - lowest) / 0.64);
+}
+
+// Issue 18, item 4: Ctrl-C while homing was read by nobody until the cut began. A stop asked for now
+// ends homing at once, outputs off.
+TEST(Cy545Link, AStopAskedWhileHomingEndsItBeforeTheNextLegWithTheOutputsOff) {
+  VirtualBench bench;
+  std::atomic<bool> stop{false};
+  bench.link.abort_on(&stop);
+  CHECK(bench.link.start(bench.clock.now_ns() + 20'000 * kMs).done);
+  stop.store(true);
+  const std::int64_t z_before = bench.mill.axis_position_steps(Axis::z);
+  const MachineResult homed = bench.link.home(bench.clock.now_ns() + bench.link.homing_bound_ns() + 20'000 * kMs);
+  CHECK(homed.refusal == MachineRefusal::Aborted);
+  STRCMP_CONTAINS("homing stopped as asked; spindle and drivers off", bench.link.last_error());
+  CHECK(bench.mill.axis_position_steps(Axis::z) - z_before == 0);
+  CHECK_FALSE(bench.mill.drivers_enabled());
+  CHECK_FALSE(bench.link.status().homed);
 }
