@@ -228,12 +228,28 @@ bool Cy545Link::latch(MonotonicNs deadline_ns) {
          clear_bit_command(kWriteStrobeBit, command) && send(command, deadline_ns);
 }
 
+bool Cy545Link::latch_motor_line(std::uint8_t channel, bool on, MonotonicNs deadline_ns) {
+  return send_bits(write_bits_code(true, on, channel, false), deadline_ns) && latch(deadline_ns);
+}
+
+// The old channel's line is latched off (data 0) before the new one's on (data 1): right whether the
+// MMC-4S latches each line's data bit (two lines on would step two axes at once) or only the
+// address (then the first strobe selects the old channel for a moment, with no step sent).
 bool Cy545Link::select_channel(std::uint8_t channel, MonotonicNs deadline_ns) {
-  if (selected_channel_ == channel && drivers_on_) {
+  if (selected_channel_ == channel && motor_line_on_ == channel && drivers_on_) {
     return true;
   }
-  if (!send_bits(write_bits_code(true, false, channel, false), deadline_ns) || !latch(deadline_ns)) {
-    return false;
+  if (motor_line_on_ != channel) {
+    if (motor_line_on_ >= 0 && !latch_motor_line(static_cast<std::uint8_t>(motor_line_on_), false, deadline_ns)) {
+      return false;
+    }
+    motor_line_on_ = -1;
+    if (!latch_motor_line(channel, true, deadline_ns)) {
+      return false;
+    }
+    motor_line_on_ = channel;
+  } else if (!send_bits(write_bits_code(true, true, channel, false), deadline_ns)) {
+    return false;  // the line is on already: only the drivers and the address bits to set again
   }
   drivers_on_ = true;
   selected_channel_ = channel;
@@ -335,6 +351,16 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
   // left (a spindle still turning after a crash), which neither "I" nor a new program clears.
   if (!force_outputs_off(deadline_ns)) {
     return fail(MachineFault::NoAnswer);
+  }
+  // And every motor channel's line off: which one a previous run left on is not known.
+  for (std::uint8_t line = 0; line < 4; ++line) {
+    if (!latch_motor_line(line, false, deadline_ns)) {
+      return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
+    }
+  }
+  motor_line_on_ = -1;
+  if (!send_bits(write_bits_code(false, false, 0, false), deadline_ns)) {  // and the drivers off again
+    return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
   }
   position_register_ = 0;
   selected_channel_ = -1;

@@ -105,6 +105,8 @@ class Cy545Link final : public MachineLink {
   bool send_bits(std::uint8_t code, MonotonicNs deadline_ns);
   bool latch(MonotonicNs deadline_ns);  // write strobe up and down
   bool select_channel(std::uint8_t channel, MonotonicNs deadline_ns);
+  // A motor channel's line latched on (data 1) or off (data 0), the drivers on.
+  bool latch_motor_line(std::uint8_t channel, bool on, MonotonicNs deadline_ns);
   // A move or seek was sent: the chip is busy for at least shortest_ns and at most longest_ns.
   void started_running(MonotonicNs shortest_ns, MonotonicNs longest_ns);
   // Waits until the chip has answered that it is free and where it is (see the .cpp), but not past
@@ -135,7 +137,8 @@ class Cy545Link final : public MachineLink {
   MachineFault fault_ = MachineFault::None;
   std::array<std::int32_t, 3> commanded_{};
   std::uint32_t position_register_ = 0;  // what "? P" must answer (24 bits)
-  int selected_channel_ = -1;            // the channel the board has latched, -1 unknown
+  int selected_channel_ = -1;            // the channel the address bits and drivers are set for, -1 not
+  int motor_line_on_ = -1;               // the motor channel whose line the board has latched on, -1 none
   bool spindle_on_ = false;
   bool drivers_on_ = false;
   bool homed_ = false;

@@ -94,10 +94,13 @@
 //         overridden for reading); while 0, bit 1 reads its latch.
 //  bit 6  busy/CTS (chip output, 1 = ready).
 //  bit 7  write strobe: on its RISING edge (0 -> 1) the output mux latches port A:
-//           A = 0..3: motor channel A becomes THE selected channel (exclusive; data bit ignored).
-//                     Step pulses go only to the selected channel. Channel 0 = X, 1 = Y, 2 = Z,
-//                     3 = unused (its steps go nowhere). ASSUMPTION: the MMC-4S carries a channel
-//                     address latch, so selecting one channel deselects the others.
+//           A = 0..3: motor channel A. Two readings (Mmc4sBoard's ChannelLatching), since the MMC-4S's
+//                     manual is not at hand: PerLine (the default, the unkinder): channel A's line
+//                     latches the data bit, 1 selects and 0 deselects it, several may be selected and
+//                     each step pulse then steps every one; Address: channel A becomes THE selected
+//                     channel, the data bit ignored. Channel 0 = X, 1 = Y, 2 = Z, 3 = unused (its steps
+//                     go nowhere). A driver correct under both deselects the old channel (data 0 at
+//                     its address) before it selects the new one (data 1).
 //           A = 4..7: general-purpose output A takes the data bit (bit 1). Output 4 = spindle (1 = on).
 //         A write-strobe level of 1 held while address bits change does not relatch. At power-up no
 //         channel is selected and every general-purpose output is 0.

@@ -28,7 +28,12 @@ void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after) {
   if (!strobe_rising) return;
   const int port = address_of(after);
   if (port < kMotorChannels) {
-    selected_channel_ = port;
+    if (latching_ == ChannelLatching::Address) {
+      channel_on_ = {};
+      channel_on_[static_cast<std::size_t>(port)] = true;
+    } else {
+      channel_on_[static_cast<std::size_t>(port)] = bit_of(after, kBitData);
+    }
     ++channel_selections_;
     return;
   }
@@ -62,13 +67,30 @@ bool Mmc4sBoard::input_level(int port) const {
   return false;
 }
 
-void Mmc4sBoard::step_pulse(StepDirection direction) {
-  const std::optional<Axis> axis = selected_channel_ ? axis_of_channel(*selected_channel_) : std::nullopt;
-  if (!axis) {
-    ++steps_to_no_channel_;
-    return;
+std::optional<int> Mmc4sBoard::selected_channel() const {
+  if (selected_channel_count() != 1) return std::nullopt;
+  for (int channel = 0; channel < kMotorChannels; ++channel) {
+    if (channel_on_[static_cast<std::size_t>(channel)]) return channel;
   }
-  static_cast<void>(mill_.step_motor(*axis, direction));
+  return std::nullopt;
+}
+
+int Mmc4sBoard::selected_channel_count() const {
+  int count = 0;
+  for (const bool on : channel_on_) count += on ? 1 : 0;
+  return count;
+}
+
+void Mmc4sBoard::step_pulse(StepDirection direction) {
+  bool stepped = false;
+  for (int channel = 0; channel < kMotorChannels; ++channel) {
+    if (!channel_on_[static_cast<std::size_t>(channel)]) continue;
+    if (const std::optional<Axis> axis = axis_of_channel(channel)) {
+      static_cast<void>(mill_.step_motor(*axis, direction));
+      stepped = true;
+    }
+  }
+  if (!stepped) ++steps_to_no_channel_;
 }
 
 bool Mmc4sBoard::general_output(int port) const {

@@ -10,9 +10,20 @@
 
 namespace stencil::sim::cy545 {
 
+// How a write strobe at a motor channel's address (0-3) acts. The MMC-4S's own manual is not at
+// hand and the thesis says only that "normally one channel is selected at a time", so the fake has
+// both readings and defaults to the unkinder: a driver must be right under either.
+enum class ChannelLatching : std::uint8_t {
+  PerLine,  // each channel's line latches the data bit: 1 selects it, 0 deselects it; several can be
+            // selected at once, and then every step pulse steps all of them
+  Address,  // the board latches the address: that channel alone is selected, the data bit ignored
+};
+
 class Mmc4sBoard {
  public:
   explicit Mmc4sBoard(SimulatedMill& mill);
+
+  void set_channel_latching(ChannelLatching latching) { latching_ = latching; }
 
   // The chip's user-bit output latches changed from `before` to `after` (bit 6 excluded).
   void on_user_bits_written(std::uint8_t before, std::uint8_t after);
@@ -23,7 +34,9 @@ class Mmc4sBoard {
   // A step pulse with the chip's direction line: goes to the selected channel's motor, if any.
   void step_pulse(StepDirection direction);
 
-  [[nodiscard]] std::optional<int> selected_channel() const { return selected_channel_; }
+  // The one selected channel; none when no channel or (PerLine) more than one is selected.
+  [[nodiscard]] std::optional<int> selected_channel() const;
+  [[nodiscard]] int selected_channel_count() const;
   [[nodiscard]] bool general_output(int port) const;
   void set_general_input(int port, bool level);
 
@@ -44,7 +57,8 @@ class Mmc4sBoard {
   [[nodiscard]] std::optional<Axis> axis_of_channel(int channel) const;
 
   SimulatedMill& mill_;
-  std::optional<int> selected_channel_;
+  ChannelLatching latching_ = ChannelLatching::PerLine;
+  std::array<bool, 4> channel_on_{};  // motor channels 0..3 (Address: at most one)
   std::array<bool, 8> outputs_{};         // general-purpose outputs 4..7 (0..3 unused)
   std::array<bool, 8> general_inputs_{};  // general-purpose inputs 4..7
   bool home_inverted_ = false;

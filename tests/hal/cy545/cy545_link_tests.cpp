@@ -300,17 +300,20 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
   CHECK(link.declare_home(clock.now_ns() + 100 * kMs).done);
   // Wake, initialise in ASCII mode, then the outputs off (spindle output 4 with the drivers off,
   // strobed; every bit low) and read back, then home declared.
-  STRCMP_EQUAL("\r? P\rI\rO 128\rR 1000\rF 1000\rS 0\r? B\rB 50H\rB 7H\r/B 7\rB 40H\r? B\rA 0\r", take().c_str());
+  // ... then every motor channel's line latched off (data 0 at addresses 0-3), the drivers off again.
+  STRCMP_EQUAL("\r? P\rI\rO 128\rR 1000\rF 1000\rS 0\r? B\rB 50H\rB 7H\r/B 7\rB 40H\r? B\r"
+               "B 41H\rB 7H\r/B 7\rB 45H\rB 7H\r/B 7\rB 49H\rB 7H\r/B 7\rB 4DH\rB 7H\r/B 7\rB 40H\rA 0\r",
+               take().c_str());
   MachineResult moved = link.move(target(5, -3, 2, {2, 0, 1}, false), clock.now_ns() + 500 * kMs);
   CHECK_TEXT(moved.done, link.last_error());
   STRCMP_EQUAL(
-      "B 49H\rB 7H\r/B 7\rN 2\r+\rG\r? P\r"   // z first: channel 2, 2 steps up, then is it done?
-      "B 41H\rB 7H\r/B 7\rN 5\r+\rG\r? P\r"   // then x: channel 0, 5 up
-      "B 45H\rB 7H\r/B 7\rN 3\r-\rG\r? P\r",  // then y: channel 1, 3 down
+      "B 4BH\rB 7H\r/B 7\rN 2\r+\rG\r? P\r"                    // z first: channel 2's line on, 2 steps up, done?
+      "B 49H\rB 7H\r/B 7\rB 43H\rB 7H\r/B 7\rN 5\r+\rG\r? P\r"   // then x: z's line off, channel 0's on, 5 up
+      "B 41H\rB 7H\r/B 7\rB 47H\rB 7H\r/B 7\rN 3\r-\rG\r? P\r",  // then y: x's off, channel 1's on, 3 down
       take().c_str());
   moved = link.move(target(9, -3, 2, {0, 1, 2}, false), clock.now_ns() + 500 * kMs);
   CHECK_TEXT(moved.done, link.last_error());
-  STRCMP_EQUAL("B 41H\rB 7H\r/B 7\rN 4\r+\rG\r? P\r", take().c_str());  // x again: its channel again
+  STRCMP_EQUAL("B 45H\rB 7H\r/B 7\rB 43H\rB 7H\r/B 7\rN 4\r+\rG\r? P\r", take().c_str());  // x again
   done = true;
   peer.join();
   close(master);
@@ -500,4 +503,26 @@ TEST(Cy545Link, AStopAskedWhileHomingEndsItBeforeTheNextLegWithTheOutputsOff) {
   CHECK(bench.mill.axis_position_steps(Axis::z) - z_before == 0);
   CHECK_FALSE(bench.mill.drivers_enabled());
   CHECK_FALSE(bench.link.status().homed);
+}
+
+// Issue 18, item 8: a board whose channel lines each latch their data bit. The old driver selected
+// with the data bit 0 and never deselected: here that selects nothing (or, once a line is on, leaves
+// it on beside the next), so the mill's axes do not follow the chip's one position register.
+TEST(Cy545Link, OnABoardThatLatchesEachChannelLineOnlyTheAxisCommandedMoves) {
+  VirtualBench bench;  // the fake's default board: PerLine
+  bench.mill.place_axis(Axis::x, 150, sim::StepDirection::positive);
+  bench.mill.place_axis(Axis::y, 60, sim::StepDirection::positive);
+  bench.mill.place_axis(Axis::z, 190, sim::StepDirection::positive);
+  CHECK_TEXT(bench.start_and_home().done, bench.link.last_error());
+  const MachineTarget path[] = {target(20, 0, 0, {0, 1, 2}, false), target(20, 15, 0, {1, 0, 2}, false),
+                                target(20, 15, 20, {2, 1, 0}, false), target(10, 5, 20, {0, 1, 2}, false)};
+  for (const MachineTarget& t : path) {
+    CHECK_TEXT(bench.link.move(t, bench.clock.now_ns() + 500 * kMs).done, bench.link.last_error());
+  }
+  CHECK_EQUAL(1, bench.fake.board().selected_channel_count());
+  // Homing's last steps were up; the last move's 10 steps back on x and y only take up their slack
+  // (80 and 32 steps), so every axis stands where its up-moves took it, and each only by its own.
+  CHECK_EQUAL(20, bench.mill.axis_position_steps(Axis::x));
+  CHECK_EQUAL(15, bench.mill.axis_position_steps(Axis::y));
+  CHECK_EQUAL(20, bench.mill.axis_position_steps(Axis::z));
 }

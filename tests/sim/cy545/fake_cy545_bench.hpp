@@ -18,6 +18,11 @@ struct FakeCy545Bench {
   SimulatedMill mill{sherline_mill_config()};
   FakeCy545 fake{mill, 0};
   PtyTestClient client{fake.slave_path()};
+  // These tests spell out the address-latching board (cy545_protocol.hpp); the per-line one has its own.
+  bool latching = [this] {
+    fake.board().set_channel_latching(ChannelLatching::Address);
+    return true;
+  }();
 
   // Writes `bytes` and hands them all to the fake at its current virtual time (no time passes, however
   // the kernel splits them). False when they did not all arrive within 2 s of wall time.

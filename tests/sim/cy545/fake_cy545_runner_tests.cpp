@@ -30,7 +30,7 @@ TEST(FakeCy545Runner, AMoveTakesAtLeastItsStepsOverRateOfWallTime) {
   FakeCy545Runner runner{fake};
   PtyTestClient client{fake.slave_path()};
   const std::int64_t x0 = mill.axis_position_steps(Axis::x);
-  CHECK_TRUE(client.write_raw("\rB 0\rB 7\r/B 7\rR 1000\rN 100\rG\r"));
+  CHECK_TRUE(client.write_raw("\rB 43H\rB 7\r/B 7\rR 1000\rN 100\rG\r"));  // X's line latched on
   const auto sent = std::chrono::steady_clock::now();
   // Wait (bounded) for the chip to take the G and then to finish it.
   const auto deadline = sent + std::chrono::seconds(3);
@@ -51,7 +51,7 @@ TEST(FakeCy545Runner, AMoveTakesAtLeastItsStepsOverRateOfWallTime) {
     LONGS_EQUAL(0, f.chip().counters().malformed_lines);
     LONGS_EQUAL(0, f.chip().counters().bytes_before_baud_lock);
     LONGS_EQUAL(6, f.chip().counters().commands_executed);
-    LONGS_EQUAL(1, f.chip().user_bit_latches());  // "B 0": bit 0, the driver enable
+    LONGS_EQUAL(3, f.chip().user_bit_latches());  // "B 43H": bit 0 the driver enable, bit 1 the data
     LONGS_EQUAL(100, f.chip().counters().steps_issued);
     LONGS_EQUAL(0, f.board().steps_to_no_channel());
     CHECK_TRUE(mill.drivers_enabled());
