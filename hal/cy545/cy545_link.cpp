@@ -213,8 +213,21 @@ bool Cy545Link::write_bytes(std::string_view bytes, MonotonicNs deadline_ns) {
   return false;
 }
 
+// Without CTS the host must give the chip time to take each command before the next (manual,
+// chapter 16): the next command's first three bytes wait in its buffer, and the settle keeps the
+// fourth from arriving while the chip still executes (see Cy545Config::command_settle_ns).
 bool Cy545Link::send(const CommandBytes& command, MonotonicNs deadline_ns) {
-  return wait_free(deadline_ns) && write_bytes(command.view(), deadline_ns);
+  if (!wait_free(deadline_ns)) {
+    return false;
+  }
+  if (quiet_until_ns_ > clock_.now_ns()) {
+    clock_.sleep_until_ns(std::min(quiet_until_ns_, deadline_ns));
+  }
+  if (!write_bytes(command.view(), deadline_ns)) {
+    return false;
+  }
+  quiet_until_ns_ = clock_.now_ns() + config_.command_settle_ns;
+  return true;
 }
 
 bool Cy545Link::send_bits(std::uint8_t code, MonotonicNs deadline_ns) {
@@ -347,20 +360,18 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
     return fault_ != MachineFault::None ? MachineResult{false, MachineRefusal::None, fault_}
                                         : refuse(MachineRefusal::DeadlineTooShort);
   }
-  // Every output to its safe value before anything moves: the board's latches keep what the last run
-  // left (a spindle still turning after a crash), which neither "I" nor a new program clears.
-  if (!force_outputs_off(deadline_ns)) {
-    return fail(MachineFault::NoAnswer);
-  }
-  // And every motor channel's line off: which one a previous run left on is not known.
+  // Every motor channel's line off (which one a previous run left on is not known), the drivers off.
   for (std::uint8_t line = 0; line < 4; ++line) {
-    if (!latch_motor_line(line, false, deadline_ns)) {
+    if (!send_bits(write_bits_code(false, false, line, false), deadline_ns) || !latch(deadline_ns)) {
       return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
     }
   }
   motor_line_on_ = -1;
-  if (!send_bits(write_bits_code(false, false, 0, false), deadline_ns)) {  // and the drivers off again
-    return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
+  // Every output to its safe value before anything moves, and read back: the board's latches keep
+  // what the last run left (a spindle still turning after a crash), which neither "I" nor a new
+  // program clears.
+  if (!force_outputs_off(deadline_ns)) {
+    return fail(MachineFault::NoAnswer);
   }
   position_register_ = 0;
   selected_channel_ = -1;

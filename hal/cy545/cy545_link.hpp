@@ -62,9 +62,11 @@ struct Cy545Config {
   MonotonicNs pace_margin_ns = 5'000'000;    // beyond its computed time a move is overdue (+ reply_timeout: a fault)
   MonotonicNs probe_interval_ns = 1'000'000; // carriage returns while waiting for "? P" to be answered
   int start_attempts = 20;                   // carriage returns and queries at start-up
-  // After each command of a stop's spindle-off and drivers-off sequence: with no CTS handshake the
-  // host must give the chip time to take a command before the next (manual, chapter 16).
-  MonotonicNs command_settle_ns = 1'000'000;
+  // After each command, before the next: with no CTS handshake the host must give the chip time to
+  // execute a command before it sends more (manual, chapter 16). The next command's first three
+  // bytes wait in the chip's buffer, so a settle s covers an execution time up to s + 4 byte times
+  // (0.69 ms at 57600 baud): 0.5 ms covers 1.2 ms. The manual gives no figure: measure it at the rig.
+  MonotonicNs command_settle_ns = 500'000;
   std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
   std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
   std::uint8_t spindle_output = 4;                            // general-purpose output (1 = on)
@@ -145,6 +147,7 @@ class Cy545Link final : public MachineLink {
   bool outputs_confirmed_off_ = false;
   const std::atomic<bool>* abort_ = nullptr;
   std::uint32_t rate_sent_ = 0;  // the R the chip holds (0: unknown)
+  MonotonicNs quiet_until_ns_ = 0;  // no command before this: the chip may still execute the last
   MonotonicNs busy_until_ns_ = 0;  // the running move's shortest end
   MonotonicNs busy_bound_ns_ = 0;  // its longest
   bool running_ = false;           // a move or seek was sent and not yet confirmed over

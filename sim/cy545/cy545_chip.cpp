@@ -157,6 +157,16 @@ void Cy545Chip::execute_line(hal::MonotonicNs at_ns) {
 }
 
 void Cy545Chip::execute(const Cy545Command& command, hal::MonotonicNs at_ns) {
+  execute_command(command, at_ns);
+  // Every command takes the chip some time even when it moves nothing (set_command_time_ns); the
+  // bytes that arrive meanwhile wait in the three-character buffer, and the rest are lost.
+  if (command_time_ns_ > 0 && activity_ == Activity::idle) {
+    delay_end_ns_ = at_ns + command_time_ns_;
+    activity_ = Activity::delaying;
+  }
+}
+
+void Cy545Chip::execute_command(const Cy545Command& command, hal::MonotonicNs at_ns) {
   const std::uint32_t argument = command.argument;
   switch (command.letter) {
     case 'A': position_ = argument; break;

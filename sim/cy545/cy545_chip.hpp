@@ -54,6 +54,13 @@ class Cy545Chip {
   // The reset pin: registers as after power-up, baud rate unlocked, buffers emptied. Board latches stay.
   void power_on_reset();
 
+  // How long the chip is busy taking a command that moves nothing (ns): the manual gives no figure,
+  // only that without CTS the host must wait for the chip to execute each command (chapter 16).
+  // 0 (the default) where bytes arrive with no wire time (the wall-clock runner cannot know when a
+  // pty's bytes left the host); FakeCy545Clock sets kCommandTimeNs, with the bytes' wire time.
+  void set_command_time_ns(hal::MonotonicNs ns) { command_time_ns_ = ns; }
+  static constexpr hal::MonotonicNs kCommandTimeNs = 1'000'000;  // ASSUMPTION: 1 ms, to be measured at the rig
+
   // Fault hook: A and P queries report the register plus this (modulo 2^24).
   void set_query_position_offset(std::int32_t steps) { query_position_offset_ = steps; }
 
@@ -82,6 +89,7 @@ class Cy545Chip {
   void parse_binary_byte(std::uint8_t byte, hal::MonotonicNs at_ns);
   void execute_line(hal::MonotonicNs at_ns);
   void execute(const Cy545Command& command, hal::MonotonicNs at_ns);
+  void execute_command(const Cy545Command& command, hal::MonotonicNs at_ns);
   void apply_bit_command(std::uint32_t argument);
   void write_user_bits(std::uint8_t latches);
   void start_move(std::uint32_t steps, StepDirection direction, hal::MonotonicNs at_ns);
@@ -145,6 +153,7 @@ class Cy545Chip {
 
   std::string output_;
   std::int32_t query_position_offset_ = 0;
+  hal::MonotonicNs command_time_ns_ = 0;
   Cy545Counters counters_;
   std::optional<Cy545LineError> last_error_;
 };

@@ -73,11 +73,15 @@ void FakeCy545::step(hal::MonotonicNs now_ns) {
 void FakeCy545::read_input(hal::MonotonicNs now_ns) {
   if (master_fd_ < 0) return;
   std::array<std::uint8_t, 256> bytes{};
+  hal::MonotonicNs at_ns = now_ns;
   for (;;) {
     const ssize_t count = read(master_fd_, bytes.data(), bytes.size());
     if (count > 0) {
       counters_.bytes_read += count;
-      for (ssize_t i = 0; i < count; ++i) chip_.receive(bytes[static_cast<std::size_t>(i)], now_ns);
+      for (ssize_t i = 0; i < count; ++i) {
+        chip_.receive(bytes[static_cast<std::size_t>(i)], at_ns);
+        at_ns += byte_time_ns_;
+      }
       continue;
     }
     if (count < 0 && errno == EINTR) continue;

@@ -38,8 +38,9 @@ class FakeCy545 {
   // The path the driver opens, e.g. /dev/pts/7.
   [[nodiscard]] const std::string& slave_path() const { return slave_path_; }
 
-  // Runs the chip to `now_ns`, then hands it every byte waiting on the pty (all arriving at `now_ns`),
-  // then writes its replies. Call it with a non-decreasing clock.
+  // Runs the chip to `now_ns`, then hands it every byte waiting on the pty (arriving from `now_ns` on,
+  // one byte time apart: set_byte_time_ns), then writes its replies. Call it with a non-decreasing clock.
+  void set_byte_time_ns(hal::MonotonicNs ns) { byte_time_ns_ = ns; }
   void step(hal::MonotonicNs now_ns);
   void advance(hal::MonotonicNs dt_ns) { step(chip_.now_ns() + dt_ns); }
   [[nodiscard]] hal::MonotonicNs now_ns() const { return chip_.now_ns(); }
@@ -78,6 +79,7 @@ class FakeCy545 {
   int master_fd_ = -1;
   int own_slave_fd_ = -1;
   std::string slave_path_;
+  hal::MonotonicNs byte_time_ns_ = 0;  // 0: a batch of bytes all arrives at once
   bool replies_suppressed_ = false;
   bool replies_garbled_ = false;
   PtyCounters counters_;

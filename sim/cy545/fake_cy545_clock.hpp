@@ -14,8 +14,12 @@ namespace stencil::sim::cy545 {
 
 class FakeCy545Clock final : public hal::Clock {
  public:
+  // The fake's bytes take their wire time, and its commands the chip's time (Cy545Chip::kCommandTimeNs).
   FakeCy545Clock(FakeCy545& fake, hal::MonotonicNs start_ns, double baud)
-      : fake_(fake), now_(start_ns), byte_ns_(static_cast<hal::MonotonicNs>(10.0 * 1e9 / baud)) {}
+      : fake_(fake), now_(start_ns), byte_ns_(static_cast<hal::MonotonicNs>(10.0 * 1e9 / baud)) {
+    fake_.set_byte_time_ns(byte_ns_);
+    fake_.chip().set_command_time_ns(Cy545Chip::kCommandTimeNs);
+  }
 
   // Time passes by the wire time of every byte that crossed the line since the last look, and while
   // the driver waits on a chip that is busy (homing or moving) with a question in its buffer, until

@@ -409,3 +409,36 @@ TEST(FakeCy545, TheByteSequencesDocumentedForTheDriverWork) {
   CHECK_FALSE(bench.mill.spindle_on());
   LONGS_EQUAL(0, bench.fake.chip().counters().malformed_lines);
 }
+
+// Issue 18, item 7: with no CTS (it needs a mode bit the driver never sets, manual chapter 16) a
+// host that sends commands back to back overruns the three-character buffer while the chip
+// executes the one before: the channel select's strobe commands are lost.
+TEST(FakeCy545, CommandsSentBackToBackOverrunTheBufferWhileTheChipTakesEachOne) {
+  Cy545Chip& chip = bench.fake.chip();
+  chip.set_command_time_ns(Cy545Chip::kCommandTimeNs);
+  constexpr stencil::hal::MonotonicNs kByte = 173'611;  // ten bits at 57600 baud
+  const std::string commands = "\rB 45H\rB 7\r/B 7\r";
+  stencil::hal::MonotonicNs at = 0;
+  for (const char c : commands) {
+    chip.receive(static_cast<std::uint8_t>(c), at += kByte);
+  }
+  bench.advance_to_ns(at + 10 * kMs);
+  CHECK(chip.counters().bytes_dropped_while_busy > 0);
+  CHECK_FALSE(bench.fake.board().selected_channel().has_value());
+}
+
+TEST(FakeCy545, CommandsPacedByHalfAMillisecondAreAllTaken) {
+  Cy545Chip& chip = bench.fake.chip();
+  chip.set_command_time_ns(Cy545Chip::kCommandTimeNs);
+  constexpr stencil::hal::MonotonicNs kByte = 173'611;
+  stencil::hal::MonotonicNs at = 0;
+  for (const std::string command : {"\r", "B 45H\r", "B 7\r", "/B 7\r"}) {
+    for (const char c : command) {
+      chip.receive(static_cast<std::uint8_t>(c), at += kByte);
+    }
+    at += 500'000;  // the driver's settle
+  }
+  bench.advance_to_ns(at + 10 * kMs);
+  LONGS_EQUAL(0, chip.counters().bytes_dropped_while_busy);
+  CHECK_EQUAL(1, bench.fake.board().selected_channel().value_or(-1));
+}
