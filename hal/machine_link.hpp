@@ -102,6 +102,11 @@ class MachineLink {
   // Asks the controller where it is and compares with what it was told: a difference is a fault.
   virtual MachineResult verify(MonotonicNs deadline_ns) = 0;
   virtual MachineResult set_spindle(bool on, MonotonicNs deadline_ns) = 0;
+  // The heartbeat the rig's hardware watchdog watches (a relay that cuts the spindle's and the
+  // drivers' power when it stops): toggled when due, nothing sent otherwise. Call it at every update,
+  // so that a process that dies, hangs or is killed leaves the mill without power within the relay's
+  // time.
+  virtual MachineResult keep_alive(MonotonicNs deadline_ns) = 0;
   // Feed hold: every move lasts at most one update, so holding takes effect at the next update.
   virtual void hold() = 0;
   virtual void resume() = 0;

@@ -120,7 +120,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
     bool stop_reported = false;
     while (!stop.load()) {
       clock.sleep_until_ns(next);
-      machine->update(next + 2 * kUpdateNs);
+      // Bounded from the update's actual start: the CY545's commands and their settles can make an
+      // update outlast its period (the mill falls behind and the backlog slows the virtual tool).
+      machine->update(std::max(next, clock.now_ns()) + 3 * kUpdateNs);
       if (job.progress && !stop_reported && machine->state() == control::MachineSideState::Stopped) {
         stop_reported = true;
         job.progress(machine->stop_confirmed()

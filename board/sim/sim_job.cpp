@@ -15,6 +15,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include <sys/resource.h>
@@ -49,6 +50,11 @@ namespace {
 
 constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
 constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
+// An update's bound from its actual start: a move of one period's steps plus the CY545's commands,
+// each with its settle (up to about 40 ms for three axes that change channel), fits in three periods;
+// an update that takes longer than a period only makes the mill fall behind (the backlog slows the
+// virtual tool), never a fault.
+constexpr hal::MonotonicNs kUpdateBoundNs = 3 * kUpdateNs;
 constexpr double kBaud = 57600.0;
 constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
 
@@ -365,9 +371,16 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
   const hal::MonotonicNs epoch_ns = realtime ? stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() : 0;
   stencil::sim::cy545::FakeCy545 fake{mill, epoch_ns};
-  stencil::sim::cy545::FakeCy545Clock fast_clock{fake, 0, kBaud};
+  // Virtual time only: it gives the fake's bytes their wire time and its commands the chip's time,
+  // which in real time the fake cannot know (a pty merges the driver's writes).
+  std::optional<stencil::sim::cy545::FakeCy545Clock> fast_clock;
+  if (!realtime) {
+    fast_clock.emplace(fake, 0, kBaud);
+  }
   hal::posix_clock::MonotonicClock wall_clock;
-  hal::Clock& machine_clock = realtime ? static_cast<hal::Clock&>(wall_clock) : fast_clock;
+  hal::Clock& machine_clock = realtime ? static_cast<hal::Clock&>(wall_clock) : *fast_clock;
+  // The rig's hardware watchdog relay on the heartbeat output (Cy545Config::heartbeat_output).
+  fake.board().arm_watchdog_relay(5, 1'000'000'000, epoch_ns);
   stencil::sim::MachinedPart machined{part, job.stock, frames, [&fake, epoch_ns] {
                                         return static_cast<double>(fake.chip().now_ns() - epoch_ns) / 1e9;
                                       }};
@@ -383,6 +396,11 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   }
   hal::cy545::Cy545Config link_config;
   link_config.homing_rate = 20000;
+  link_config.homing_slow_rate = 2000;
+  if (realtime) {
+    // The fake answers from a thread on a host that is not real-time: a late reply is its scheduling.
+    link_config.reply_timeout_ns = 250'000'000;
+  }
   hal::cy545::Cy545Link link(port, machine_clock, link_config);
 
   auto rings = std::make_unique<control::CycleRingStorage>();
@@ -491,7 +509,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
       hal::MonotonicNs next = machine_clock.now_ns();
       while (!stop.load()) {
         machine_clock.sleep_until_ns(next);
-        machine->update(next + 2 * kUpdateNs);
+        machine->update(std::max(next, machine_clock.now_ns()) + kUpdateBoundNs);
         fake_runner->with_fake([&](stencil::sim::cy545::FakeCy545&) { machined.flush(); });
         if (job.display != nullptr) {
           job.display->on_machine(machine->statistics().last_lag_mm, model);
@@ -577,7 +595,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   for (;;) {
     if (cycle_ns >= next_update_ns && cycle_ns >= machine_clock.now_ns()) {
       machine_clock.sleep_until_ns(cycle_ns);
-      machine->update(machine_clock.now_ns() + 2 * kUpdateNs);
+      machine->update(machine_clock.now_ns() + kUpdateBoundNs);
       machined.flush();
       if (job.display != nullptr) {
         job.display->on_machine(machine->statistics().last_lag_mm, model);

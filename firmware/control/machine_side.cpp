@@ -71,6 +71,10 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     stop(update_deadline_ns, false);
     return;
   }
+  if (!link_.keep_alive(update_deadline_ns).done) {  // the watchdog relay's heartbeat, every update
+    stop(update_deadline_ns, true);
+    return;
+  }
   const std::uint64_t moves_done = link_.status().moves_done;
   const auto completed = static_cast<int>(std::min<std::uint64_t>(moves_done - moves_seen_, 8));
   moves_seen_ = moves_done;

@@ -428,6 +428,16 @@ Cy545Link::SwitchReading Cy545Link::read_home_switch(std::size_t axis, Monotonic
 
 bool Cy545Link::homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns) {
   CommandBytes command{};
+  // Homing takes minutes: the watchdog must not drop meanwhile. A heartbeat sent moved the address
+  // lines and the read strobe: the home switch goes back on the input line.
+  const MonotonicNs heartbeat_due = heartbeat_due_ns_;
+  if (!keep_alive(deadline_ns).done) {
+    return false;
+  }
+  if (heartbeat_due_ns_ != heartbeat_due && homing_input_ >= 0 &&
+      !send_bits(write_bits_code(true, false, static_cast<std::uint8_t>(homing_input_), true), deadline_ns)) {
+    return false;
+  }
   if (rate != rate_sent_) {
     if (!number_command('R', rate, 27000, command) || !send(command, deadline_ns)) {
       return false;
@@ -455,6 +465,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     return false;
   }
   selected_channel_ = -1;  // the address lines now carry the input's number
+  homing_input_ = config_.home_input[axis];
   const std::int32_t chunk = std::max(config_.homing_chunk_steps, 1);
   const int debounce = std::max(config_.homing_debounce_reads, 1);
   // Before anything moves: a closed switch means the axis is inside its zone; leave it first.
@@ -549,6 +560,7 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
     }
     position_register_ = 0;
   }
+  homing_input_ = -1;
   // Read strobe off, the moving rate back, then the position must be the home's.
   CommandBytes command{};
   std::uint32_t position = 1;
@@ -671,6 +683,29 @@ MachineResult Cy545Link::set_spindle(bool on, MonotonicNs deadline_ns) {
   }
   selected_channel_ = -1;  // the address lines were the spindle output's
   spindle_on_ = on;
+  return {true, MachineRefusal::None, MachineFault::None};
+}
+
+MachineResult Cy545Link::keep_alive(MonotonicNs deadline_ns) {
+  if (config_.heartbeat_output < 0) {
+    return {true, MachineRefusal::None, MachineFault::None};
+  }
+  if (fault_ != MachineFault::None) {
+    return refuse(MachineRefusal::Faulted);
+  }
+  if (state_ == MachineState::Closed || state_ == MachineState::Open) {
+    return refuse(MachineRefusal::NotHomed);
+  }
+  if (clock_.now_ns() < heartbeat_due_ns_) {
+    return {true, MachineRefusal::None, MachineFault::None};
+  }
+  const auto port = static_cast<std::uint8_t>(config_.heartbeat_output);
+  if (!send_bits(write_bits_code(drivers_on_, !heartbeat_level_, port, false), deadline_ns) || !latch(deadline_ns)) {
+    return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
+  }
+  selected_channel_ = -1;  // the address lines were the heartbeat output's (the motor line stays latched)
+  heartbeat_level_ = !heartbeat_level_;
+  heartbeat_due_ns_ = clock_.now_ns() + config_.heartbeat_period_ns / 2;
   return {true, MachineRefusal::None, MachineFault::None};
 }
 

@@ -70,6 +70,10 @@ struct Cy545Config {
   std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
   std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
   std::uint8_t spindle_output = 4;                            // general-purpose output (1 = on)
+  // The watchdog relay's heartbeat: a general-purpose output toggled every heartbeat_period_ns / 2
+  // while the machine side runs (homing included); -1: none (a rig without the relay).
+  int heartbeat_output = 5;
+  MonotonicNs heartbeat_period_ns = 400'000'000;  // the relay drops after about 1 s without a change
 };
 
 class Cy545Link final : public MachineLink {
@@ -84,6 +88,7 @@ class Cy545Link final : public MachineLink {
   MachineResult move(const MachineTarget& target, MonotonicNs deadline_ns) override;
   MachineResult verify(MonotonicNs deadline_ns) override;
   MachineResult set_spindle(bool on, MonotonicNs deadline_ns) override;
+  MachineResult keep_alive(MonotonicNs deadline_ns) override;
   void hold() override;
   void resume() override;
   MachineResult stop(MonotonicNs deadline_ns) override;
@@ -147,6 +152,9 @@ class Cy545Link final : public MachineLink {
   bool outputs_confirmed_off_ = false;
   const std::atomic<bool>* abort_ = nullptr;
   std::uint32_t rate_sent_ = 0;  // the R the chip holds (0: unknown)
+  bool heartbeat_level_ = false;
+  int homing_input_ = -1;  // while homing: the input-mux port the read strobe must show
+  MonotonicNs heartbeat_due_ns_ = 0;
   MonotonicNs quiet_until_ns_ = 0;  // no command before this: the chip may still execute the last
   MonotonicNs busy_until_ns_ = 0;  // the running move's shortest end
   MonotonicNs busy_bound_ns_ = 0;  // its longest

@@ -245,7 +245,7 @@ void Cy545Chip::apply_bit_command(std::uint32_t argument) {
 void Cy545Chip::write_user_bits(std::uint8_t latches) {
   const std::uint8_t before = latches_;
   latches_ = static_cast<std::uint8_t>(latches & ~kBusyBit);  // bit 6 belongs to the chip's CTS
-  board_.on_user_bits_written(before, latches_);
+  board_.on_user_bits_written(before, latches_, now_ns_);
 }
 
 void Cy545Chip::start_move(std::uint32_t steps, StepDirection direction, hal::MonotonicNs at_ns) {

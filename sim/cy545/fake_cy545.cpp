@@ -66,6 +66,7 @@ bool FakeCy545::wait_for_input(int timeout_ms) const {
 
 void FakeCy545::step(hal::MonotonicNs now_ns) {
   chip_.advance_to(now_ns);
+  board_.advance_to(now_ns);
   read_input(now_ns);
   flush_replies();
 }

@@ -22,8 +22,28 @@ Mmc4sBoard::Mmc4sBoard(SimulatedMill& mill) : mill_(mill) {
   mill_.set_spindle_on(false);
 }
 
-void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after) {
-  mill_.set_drivers_enabled(bit_of(after, kBitDriverEnable));
+void Mmc4sBoard::apply_power() {
+  mill_.set_drivers_enabled(drivers_latched_ && relay_closed_);
+  mill_.set_spindle_on(outputs_[static_cast<std::size_t>(rig::kMmc4s.spindle_output)] && relay_closed_);
+}
+
+void Mmc4sBoard::arm_watchdog_relay(int port, hal::MonotonicNs timeout_ns, hal::MonotonicNs now_ns) {
+  relay_port_ = port;
+  relay_timeout_ns_ = timeout_ns;
+  last_heartbeat_ns_ = now_ns;
+}
+
+void Mmc4sBoard::advance_to(hal::MonotonicNs now_ns) {
+  if (relay_port_ >= 0 && relay_closed_ && now_ns - last_heartbeat_ns_ > relay_timeout_ns_) {
+    relay_closed_ = false;
+    apply_power();
+  }
+}
+
+void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after, hal::MonotonicNs at_ns) {
+  advance_to(at_ns);
+  drivers_latched_ = bit_of(after, kBitDriverEnable);
+  apply_power();
   const bool strobe_rising = !bit_of(before, kBitWriteStrobe) && bit_of(after, kBitWriteStrobe);
   if (!strobe_rising) return;
   const int port = address_of(after);
@@ -37,8 +57,13 @@ void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after) {
     ++channel_selections_;
     return;
   }
-  outputs_[static_cast<std::size_t>(port)] = bit_of(after, kBitData);
-  if (port == rig::kMmc4s.spindle_output) mill_.set_spindle_on(outputs_[static_cast<std::size_t>(port)]);
+  const bool level = bit_of(after, kBitData);
+  if (port == relay_port_ && level != outputs_[static_cast<std::size_t>(port)]) {
+    last_heartbeat_ns_ = at_ns;
+    relay_closed_ = true;
+  }
+  outputs_[static_cast<std::size_t>(port)] = level;
+  apply_power();
 }
 
 std::optional<Axis> Mmc4sBoard::axis_of_channel(int channel) const {

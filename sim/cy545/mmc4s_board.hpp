@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <optional>
 
+#include "hal/clock.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
 namespace stencil::sim::cy545 {
@@ -25,8 +26,16 @@ class Mmc4sBoard {
 
   void set_channel_latching(ChannelLatching latching) { latching_ = latching; }
 
-  // The chip's user-bit output latches changed from `before` to `after` (bit 6 excluded).
-  void on_user_bits_written(std::uint8_t before, std::uint8_t after);
+  // The chip's user-bit output latches changed from `before` to `after` (bit 6 excluded), at `at_ns`.
+  void on_user_bits_written(std::uint8_t before, std::uint8_t after, hal::MonotonicNs at_ns = 0);
+
+  // The rig's hardware watchdog (README): a relay in the spindle's and the drivers' power that opens
+  // when general-purpose output `port` has not changed for `timeout_ns`, and closes again at its next
+  // change. Not armed by default: it is wiring beside the board, not the board.
+  void arm_watchdog_relay(int port, hal::MonotonicNs timeout_ns, hal::MonotonicNs now_ns);
+  // Opens the relay once the heartbeat is overdue (the fake calls it as its clock moves).
+  void advance_to(hal::MonotonicNs now_ns);
+  [[nodiscard]] bool watchdog_relay_closed() const { return relay_closed_; }
 
   // The level of input-mux port `port` (0..7).
   [[nodiscard]] bool input_level(int port) const;
@@ -61,6 +70,13 @@ class Mmc4sBoard {
   std::array<bool, 4> channel_on_{};  // motor channels 0..3 (Address: at most one)
   std::array<bool, 8> outputs_{};         // general-purpose outputs 4..7 (0..3 unused)
   std::array<bool, 8> general_inputs_{};  // general-purpose inputs 4..7
+  void apply_power();  // the mill's spindle and drivers: the latches, through the relay
+
+  int relay_port_ = -1;
+  hal::MonotonicNs relay_timeout_ns_ = 0;
+  hal::MonotonicNs last_heartbeat_ns_ = 0;
+  bool relay_closed_ = true;
+  bool drivers_latched_ = false;
   bool home_inverted_ = false;
   std::int64_t bounce_band_steps_ = 0;
   mutable std::uint32_t bounce_state_ = 0x9E3779B9U;  // xorshift32: reads near an edge advance it

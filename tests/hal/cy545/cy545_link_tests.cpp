@@ -546,3 +546,26 @@ TEST(Cy545Link, WithoutTheSettleBetweenCommandsTheChipLosesBytes) {
   LONGS_EQUAL(0, paced.fake.chip().counters().malformed_lines);
   CHECK(bench.fake.chip().counters().malformed_lines > 0 || !started.done);
 }
+
+// Issue 18, item 1: no software survives SIGKILL or a power cut; the rig's hardware watchdog (a
+// relay in the spindle's and drivers' power) drops when the heartbeat output stops changing. The
+// driver beats it at every update and through homing; a process that stops beating leaves the mill
+// without power within the relay's time.
+TEST(Cy545Link, TheWatchdogRelayStaysClosedWhileTheDriverBeatsAndDropsWhenItStops) {
+  VirtualBench bench;
+  bench.fake.board().arm_watchdog_relay(5, 1'000 * kMs, bench.clock.now_ns());
+  CHECK_TEXT(bench.start_and_home().done, bench.link.last_error());  // homing from mid-travel: about 45 s
+  CHECK(bench.fake.board().watchdog_relay_closed());
+  CHECK(bench.link.set_spindle(true, bench.clock.now_ns() + 200 * kMs).done);
+  for (int update = 0; update < 90; ++update) {  // three seconds of updates
+    CHECK(bench.link.keep_alive(bench.clock.now_ns() + 60 * kMs).done);
+    bench.clock.sleep_until_ns(bench.clock.now_ns() + 33 * kMs);
+  }
+  CHECK(bench.fake.board().watchdog_relay_closed());
+  CHECK(bench.mill.spindle_on());
+  // The process is killed: nothing more is sent.
+  bench.fake.step(bench.clock.now_ns() + 1'500 * kMs);
+  CHECK_FALSE(bench.fake.board().watchdog_relay_closed());
+  CHECK_FALSE(bench.mill.spindle_on());
+  CHECK_FALSE(bench.mill.drivers_enabled());
+}
