@@ -69,6 +69,8 @@ struct FakeRig {
     CHECK_TRUE(port.open(fake.slave_path().c_str(), port_error));
     hal::cy545::Cy545Config config;
     config.homing_rate = 20000;  // the fake homes in a fraction of a second
+    config.homing_slow_rate = 5000;
+    config.reply_timeout_ns = 250'000'000;  // the fake is a thread on a host that is not real-time
     link = std::make_unique<hal::cy545::Cy545Link>(port, clock, config);
     window = hal::pio_shared_memory::SharedWindowMapping::create_memfd("rig-loop-tests", error);
     CHECK(window != nullptr);
