@@ -41,6 +41,7 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
   config.device_high_mm = Eigen::Vector3d(kRig.haptic_workspace_mm[0] + 25.0, kRig.haptic_workspace_mm[1] + 25.0,
                                           kRig.haptic_workspace_mm[2] + 25.0);
   config.home_tip_mm = frames.home_world_mm;
+  config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.count_overruns = true;
   config.overrun_limit = job.overrun_limit;
   config.stale_periods = job.stale_periods;

@@ -60,6 +60,9 @@ struct RigJob {
   // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
   // hosts they run on are not real-time hosts (make latency measures what a host gives).
   int overrun_limit = 3;
+  // The cycle starts held (no tool motion, no force) until the hand is held still near the tool, as
+  // for a reset: on the rig always; the tests' scripted hands, which move from the start, turn it off.
+  bool start_held = true;
   // More periods than this without a fresh device sample is a safe state: 5 on the rig (the tests
   // raise it for the same reason: their simulated device is a thread on a host that stalls).
   int stale_periods = 5;

@@ -30,6 +30,7 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
   board_force_limit_n_ = config.haptic.max_force_n;
   board_axis_move_mm_ = config.max_axis_move_mm;
   board_total_move_mm_ = config.max_total_move_mm;
+  waiting_for_hand_ = config.start_held;
 }
 
 ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
@@ -75,6 +76,17 @@ void Controller::enter_safe_state(SafeReason reason) {
   write_zero_force();  // at once, whatever else this cycle still does
 }
 
+ResetOutcome Controller::hand_held_near_tool(hal::MonotonicNs now_ns) const {
+  if (static_cast<double>(now_ns - still_since_ns_) < config_.still_time_s * kNsPerS) {
+    return ResetOutcome::DeviceNotStill;
+  }
+  const Eigen::Vector3d tool_on_device = motion::world_to_device(config_.frames, tool_.tip_mm());
+  if ((position_of(sample_) - tool_on_device).norm() > config_.reset_distance_mm) {
+    return ResetOutcome::DeviceFarFromTool;
+  }
+  return ResetOutcome::Accepted;
+}
+
 ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
   if (safe_reason_ == SafeReason::None) {
     return ResetOutcome::NotInSafeState;
@@ -87,12 +99,9 @@ ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
       device_.latched_fault() != hal::HapticFault::None) {
     return ResetOutcome::DeviceNotReady;
   }
-  if (static_cast<double>(now_ns - still_since_ns_) < config_.still_time_s * kNsPerS) {
-    return ResetOutcome::DeviceNotStill;
-  }
-  const Eigen::Vector3d tool_on_device = motion::world_to_device(config_.frames, tool_.tip_mm());
-  if ((position_of(sample_) - tool_on_device).norm() > config_.reset_distance_mm) {
-    return ResetOutcome::DeviceFarFromTool;
+  const ResetOutcome hand = hand_held_near_tool(now_ns);
+  if (hand != ResetOutcome::Accepted) {
+    return hand;
   }
   safe_reason_ = SafeReason::None;
   ramp_start_ns_ = now_ns;
@@ -249,7 +258,15 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   const Eigen::Vector3d desired = motion::device_to_world(config_.frames, device);
   engine::ContactResult contact{engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   engine::HapticOutput output{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false};
-  if (safe_reason_ == SafeReason::None && usable) {
+  // A held start: nothing follows the hand until it is held still near the tool, as for a reset, so
+  // a handle left resting away from the tool cannot pull the tool (and the mill) the moment it starts.
+  if (waiting_for_hand_ && safe_reason_ == SafeReason::None && usable &&
+      hand_held_near_tool(now_ns) == ResetOutcome::Accepted) {
+    waiting_for_hand_ = false;
+    ramp_start_ns_ = now_ns;
+    ramping_ = true;
+  }
+  if (safe_reason_ == SafeReason::None && usable && !waiting_for_hand_) {
     // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
     // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
     const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
@@ -270,8 +287,11 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     }
   }
 
-  // The force: zero in the safe state (already written when it was entered), ramped in after a reset.
-  if (safe_reason_ == SafeReason::None) {
+  // The force: zero in the safe state (already written when it was entered) and while a held start
+  // waits for the hand, ramped in after a reset or the start.
+  if (safe_reason_ == SafeReason::None && waiting_for_hand_) {
+    write_zero_force();
+  } else if (safe_reason_ == SafeReason::None) {
     double scale = 1.0;
     if (ramping_) {
       const double elapsed = static_cast<double>(now_ns - ramp_start_ns_) / kNsPerS;

@@ -42,6 +42,9 @@ struct ControllerConfig {
   double still_time_s = 0.5;              // ... for this long ...
   double reset_distance_mm = 5.0;         // ... and this near the virtual tool (device mm)
   double ramp_time_s = 0.5;               // force comes back over this long after a reset
+  // The rig: the cycle starts held (zero force, the virtual tool at home) until the hand is held as
+  // for a reset (still, near the tool); the simulation's scripted hand starts at once.
+  bool start_held = false;
   double period_s = 1e-3;                 // the cycle's period: a speed limit in mm/s is this much per step
   // The operator may set the coupling within [min, max] (N per device mm); the force limit and the
   // speed limit only ever below the board's (haptic.max_force_n and the move limits above).
@@ -76,6 +79,8 @@ class Controller {
 
   // False when the grown contact tool could not be built (bad tool in the tables): do not run.
   [[nodiscard]] bool ready() const { return ready_; }
+  // A held start still waiting for the hand (ControllerConfig::start_held).
+  [[nodiscard]] bool waiting_for_hand() const { return waiting_for_hand_; }
 
   // One cycle, started at now_ns for the period that was due at deadline_ns. Real-time safe: no
   // allocation, lock, throw or blocking call; bounded work (the engine's bounds, the command ring's
@@ -109,6 +114,8 @@ class Controller {
   void write_zero_force();
   void handle_commands(hal::MonotonicNs now_ns);
   [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);
+  // The reset rule's hand: still long enough, near enough the virtual tool (Accepted when both).
+  [[nodiscard]] ResetOutcome hand_held_near_tool(hal::MonotonicNs now_ns) const;
   [[nodiscard]] ParameterOutcome set_parameter(CommandKind kind, double value);
   // Reads the device and checks the sample; false when the cycle must not render force.
   [[nodiscard]] bool read_device(hal::MonotonicNs now_ns);
@@ -135,6 +142,7 @@ class Controller {
   hal::MonotonicNs still_since_ns_ = 0;    // the device has been slower than the still speed since
   hal::MonotonicNs ramp_start_ns_ = 0;     // force ramps in from here after a reset (or the start)
   bool ramping_ = true;
+  bool waiting_for_hand_ = false;  // a held start (config.start_held) until the hand is held near the tool
   int consecutive_overruns_ = 0;
   double backlog_percent_ = 0.0;           // the mill's path still to follow, from its last update
   hal::MonotonicNs step_start_ns_ = 0;

@@ -517,3 +517,38 @@ TEST(Controller, ASpeedLimitNeverRaisesTheMillsAndALowerOneSlowsTheVirtualTool) 
   CHECK(bench.cycle() == CycleStatus::Running);
   DOUBLES_EQUAL(0.25e-3, (bench.controller->virtual_tip_mm() - before).cwiseAbs().sum(), 1e-12);
 }
+
+// Issue 18, item 4: on the rig a handle resting 5 mm from the tool used to pull the tool (and the
+// mill) 30 ms after the spindle came on, with 5 N on the handle. A held start does nothing until the
+// hand is held as for a reset: still for the still time, near the tool.
+TEST(Controller, AHeldStartIgnoresAHandRestingAwayFromTheToolAndWritesNoForce) {
+  ControllerConfig c = config();
+  c.start_held = true;
+  Bench bench(c);
+  bench.device.hold_at(kHomeDevice.x() + 50.0, kHomeDevice.y(), kHomeDevice.z());  // 5 mm (world) away
+  bench.cycles(2000);
+  CHECK(bench.controller->waiting_for_hand());
+  CHECK((bench.controller->virtual_tip_mm() - kHomeWorld).norm() < 1e-12);
+  DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+}
+
+TEST(Controller, AHeldStartBeginsOnceTheHandIsHeldStillNearTheToolAndRampsTheForceIn) {
+  ControllerConfig c = config();
+  c.start_held = true;
+  Bench bench(c);
+  bench.device.hold_at(kHomeDevice.x() + 2.0, kHomeDevice.y(), kHomeDevice.z());  // near, still
+  bench.cycles(400);
+  CHECK(bench.controller->waiting_for_hand());  // not still for long enough yet
+  bench.cycles(200);
+  CHECK_FALSE(bench.controller->waiting_for_hand());
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(30.0, 0.0, 0.0), 500.0);
+  CHECK(bench.controller->virtual_tip_mm().x() > kHomeWorld.x() + 1.0);  // it follows now
+}
+
+TEST(Controller, WithoutAHeldStartTheToolFollowsFromTheFirstCycle) {
+  Bench bench;
+  CHECK_FALSE(bench.controller->waiting_for_hand());
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(30.0, 0.0, 0.0), 500.0);
+  CHECK(bench.controller->virtual_tip_mm().x() > kHomeWorld.x() + 1.0);
+}

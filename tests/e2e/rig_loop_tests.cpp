@@ -112,6 +112,7 @@ struct FakeRig {
 
   rig::RigJob job(double duration_s) {
     rig::RigJob j;
+    j.start_held = false;  // the scripted hands move from the first millisecond (the held start: control_tests)
     j.part = &part;
     j.device = host.get();
     j.machine = link.get();
@@ -255,7 +256,7 @@ TEST(RigLoop, AJobCarriedOnFromItsJournalRebuildsWhatWasCutAndHomesAgain) {
   std::string error;
   FakeRig rig;
   const motion::MachineFrames frames = rig::rig_frames({});
-  CHECK_TRUE(journal::read_job_history(path, rig.part.header.crc32, rig.part.header.triangle_count, frames, {}, before, error));
+  CHECK_TEXT(journal::read_job_history(path, rig.part.header.crc32, rig.part.header.triangle_count, frames, {}, before, error), error.c_str());
   LONGS_EQUAL(1, before.homings);
   CHECK(before.machine_commands >= first.machine_updates && before.machine_commands > 0);
   CHECK_FALSE(before.endings[0].recorded);
