@@ -105,9 +105,18 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   // A stop asked for while the mill wakes or homes is taken between two of its commands, not after.
   job.machine->abort_on(job.interrupted);
   // Wake-up and spindle in seconds; homing as long as the link says it can take from anywhere.
-  if (!machine->start(clock.now_ns() + job.machine->homing_bound_ns() + 20'000'000'000)) {
+  if (!machine->home(clock.now_ns() + job.machine->homing_bound_ns() + 20'000'000'000)) {
     result.error = machine->record_failed() ? "the machine did not start: its homing could not be journalled: " + job.journal->error()
-                                            : "the machine did not start (wake, home, spindle on)";
+                                            : "the machine did not start (wake, home)";
+    return result;
+  }
+  if (job.confirm_spindle && !job.confirm_spindle()) {
+    static_cast<void>(job.machine->stop(clock.now_ns() + 2 * kUpdateNs));  // drivers off: nothing runs unattended
+    result.error = "the spindle was not confirmed: nothing was cut";
+    return result;
+  }
+  if (!machine->start_spindle(clock.now_ns() + 2 * kUpdateNs)) {
+    result.error = "the machine did not start (spindle on)";
     return result;
   }
   result.started = true;

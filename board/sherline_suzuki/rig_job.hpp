@@ -67,6 +67,9 @@ struct RigJob {
   // raise it for the same reason: their simulated device is a thread on a host that stalls).
   int stale_periods = 5;
   std::function<void(const std::string&)> progress;  // a line about every second, and every event
+  // Once homed, before the spindle starts: blocks until the operator confirms (true) or the job is
+  // to end (false: the mill stays homed with the spindle off and the run ends). Null: no confirmation.
+  std::function<bool()> confirm_spindle;
   // Polled by the records thread: true when the operator asks for a reset (typed at the terminal).
   std::function<bool()> reset_requested;
   // An operator display (--hmi): fed by the records and machine threads, never the cycle; its

@@ -37,6 +37,7 @@
 #include "hal/cy545/serial_port.hpp"
 #include "hal/pio_shared_memory/shared_window_mapping.hpp"
 #include "hal/socketcan/can_frame_layout.hpp"
+#include "hal/socketcan/can_interface_bitrate.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 
 namespace {
@@ -58,20 +59,29 @@ void on_signal(int) { interrupted.store(true); }
 // once a line says "reset". Anything else typed is answered with what is understood.
 class TerminalCommands {
  public:
+  enum class Word { None, Start, Closed };
+  // Before the cut: whether 'start' was typed (anything else is answered), or the input closed.
+  Word next_word() {
+    read_pending();
+    for (std::size_t end = pending_.find('\n'); end != std::string::npos; end = pending_.find('\n')) {
+      std::string line = pending_.substr(0, end);
+      pending_.erase(0, end + 1);
+      while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) {
+        line.pop_back();
+      }
+      if (line == "start") {
+        return Word::Start;
+      }
+      std::fprintf(stderr, "stencil-rig: '%s' is not 'start': type 'start' to turn the spindle on, or Ctrl-C\n", line.c_str());
+    }
+    return closed_ ? Word::Closed : Word::None;
+  }
+
   bool reset_typed() {
     if (closed_) {
       return false;
     }
-    pollfd in{STDIN_FILENO, POLLIN, 0};
-    while (poll(&in, 1, 0) > 0 && (in.revents & (POLLIN | POLLHUP)) != 0) {
-      char bytes[256];
-      const ssize_t n = ::read(STDIN_FILENO, bytes, sizeof bytes);
-      if (n <= 0) {
-        closed_ = true;  // end of input (not a terminal, or closed): nothing more to read
-        break;
-      }
-      pending_.append(bytes, static_cast<std::size_t>(n));
-    }
+    read_pending();
     bool reset = false;
     for (std::size_t end = pending_.find('\n'); end != std::string::npos; end = pending_.find('\n')) {
       std::string line = pending_.substr(0, end);
@@ -93,6 +103,19 @@ class TerminalCommands {
   }
 
  private:
+  void read_pending() {
+    pollfd in{STDIN_FILENO, POLLIN, 0};
+    while (!closed_ && poll(&in, 1, 0) > 0 && (in.revents & (POLLIN | POLLHUP)) != 0) {
+      char bytes[256];
+      const ssize_t n = ::read(STDIN_FILENO, bytes, sizeof bytes);
+      if (n <= 0) {
+        closed_ = true;  // end of input (not a terminal, or closed): nothing more to read
+        break;
+      }
+      pending_.append(bytes, static_cast<std::size_t>(n));
+    }
+  }
+
   std::string pending_;
   bool closed_ = false;
 };
@@ -278,6 +301,12 @@ int main(int argc, char** argv) {
       return fail(kExitNotStarted, "the haptic device's CAN link: " + error);
     }
     channel = std::make_unique<hal::socketcan::FdCanChannel>(fd);
+    // A bus too slow for a period's frames is refused here, not found out as late poses in the cycle.
+    std::string bitrate_note;
+    if (!hal::socketcan::check_can_bitrate(interface, bitrate_note, error)) {
+      return fail(kExitNotStarted, "the haptic device's CAN link: " + error);
+    }
+    std::printf("stencil-rig: %s\n", bitrate_note.c_str());
     can_device = std::make_unique<hal::socketcan::SocketCanHapticDevice>(channel.get(), hal::kCornerOriginHapticRange);
     device = can_device.get();
   }
@@ -383,7 +412,25 @@ int main(int argc, char** argv) {
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
   TerminalCommands terminal;
   job.reset_requested = [&terminal] { return terminal.reset_typed(); };
-  std::printf("stencil-rig: homing the mill, then cutting; Ctrl-C stops (homing too)\n");
+  // Nothing turns the spindle on unattended: once homed, the operator types 'start' at the terminal.
+  job.confirm_spindle = [&terminal] {
+    std::printf("stencil-rig: homed. Hold the handle still near the tool, then type 'start' and Enter to turn the "
+                "spindle on (Ctrl-C ends)\n");
+    std::fflush(stdout);
+    while (!interrupted.load()) {
+      const TerminalCommands::Word word = terminal.next_word();
+      if (word == TerminalCommands::Word::Start) {
+        return true;
+      }
+      if (word == TerminalCommands::Word::Closed) {
+        std::fprintf(stderr, "stencil-rig: no operator at the terminal (its input is closed): the spindle stays off\n");
+        return false;
+      }
+      usleep(100'000);
+    }
+    return false;
+  };
+  std::printf("stencil-rig: homing the mill (Ctrl-C stops it); the spindle starts only once you type 'start'\n");
   std::fflush(stdout);
   const app::RealtimeOptions options{priority, cpu, require_rt};
   const board::sherline_suzuki::RigResult result = board::sherline_suzuki::run_rig(

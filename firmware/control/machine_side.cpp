@@ -10,18 +10,25 @@ MachineSide::MachineSide(const tables::PartTables& part, hal::MachineLink& link,
     : link_(link), from_cycle_(from_cycle), to_cycle_(to_cycle), planner_(part, frames, limits),
       commanded_tip_mm_(frames.home_world_mm) {}
 
-bool MachineSide::start(hal::MonotonicNs deadline_ns) {
+bool MachineSide::home(hal::MonotonicNs deadline_ns) {
   // The homing is in the record before anything moves: from it on the tool is at home, whatever the
   // record said before (a resumed job starts here). Not recorded: nothing moves, the spindle stays off.
   if (recorder_ != nullptr && !recorder_->homed(deadline_ns)) {
     record_failed_ = true;
     return false;
   }
-  if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done || !link_.set_spindle(true, deadline_ns).done) {
+  if (!link_.start(deadline_ns).done || !link_.home(deadline_ns).done) {
     return false;
   }
   planner_.homed({{0, 0, 0}}, link_.home_approach());
   moves_seen_ = link_.status().moves_done;
+  return true;
+}
+
+bool MachineSide::start_spindle(hal::MonotonicNs deadline_ns) {
+  if (!link_.status().homed || !link_.set_spindle(true, deadline_ns).done) {
+    return false;
+  }
   state_ = MachineSideState::Cutting;
   return true;
 }

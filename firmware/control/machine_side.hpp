@@ -37,8 +37,11 @@ class MachineSide {
               MachineHandoffRing& from_cycle, MachineEventRing& to_cycle);
 
   // Init: wakes the controller, homes on the switches, turns the spindle on. False with the link's
-  // fault on failure (nothing moves then).
-  [[nodiscard]] bool start(hal::MonotonicNs deadline_ns);
+  // fault on failure (nothing moves then). home() then start_spindle() are the same in two steps,
+  // for a rig whose operator confirms before the spindle starts.
+  [[nodiscard]] bool start(hal::MonotonicNs deadline_ns) { return home(deadline_ns) && start_spindle(deadline_ns); }
+  [[nodiscard]] bool home(hal::MonotonicNs deadline_ns);
+  [[nodiscard]] bool start_spindle(hal::MonotonicNs deadline_ns);
 
   // One machine update, by update_deadline_ns: drains the cycle's handoffs, then plans and sends
   // at most one target. A fault here is reported to the cycle and stops the machine.

@@ -284,3 +284,21 @@ TEST(RigLoop, AJobCarriedOnFromItsJournalRebuildsWhatWasCutAndHomesAgain) {
   CHECK(after.cycles > before.cycles);
   std::remove(path.c_str());
 }
+
+// Issue 18, item 4: the spindle came on unattended right after homing. Now the rig asks the operator
+// first; an answer that never comes (input closed, Ctrl-C) leaves it off, drivers off, nothing cut.
+TEST(RigLoop, TheSpindleStartsOnlyOnceTheOperatorConfirms) {
+  FakeRig rig;
+  rig::RigJob job = rig.job(1.0);
+  bool asked_while_homed = false;
+  job.confirm_spindle = [&] {
+    asked_while_homed = rig.link->status().homed && !rig.spindle_on();
+    return false;
+  };
+  const rig::RigResult result = rig::run_rig(job, unprivileged_runner());
+  CHECK_TRUE(asked_while_homed);
+  CHECK_FALSE(result.started);
+  STRCMP_CONTAINS("not confirmed", result.error.c_str());
+  CHECK_FALSE(rig.spindle_on());
+  CHECK_FALSE(rig.fake_runner->with_fake([&](sim::cy545::FakeCy545&) { return rig.mill.drivers_enabled(); }));
+}
