@@ -63,6 +63,9 @@ enum class WriteStatus : std::uint8_t {
   Clamped,   // sent with force and/or torque clamped to the range
   Rejected,  // not finite: zero force with enable off was sent in its place (the heartbeat still beats)
   Fault,     // could not be sent (see reason)
+  Held,      // enable on was asked, but the device has not confirmed that it is armed (its host watchdog
+             // is clear after an enable off of this host's), or a HostWatchdogTripped has not been
+             // cleared: zero force with enable off was sent in its place. Not a fault.
 };
 
 // Why a read or write was not Fresh / Written. Also the value of the error latch.
@@ -77,6 +80,8 @@ enum class HapticFault : std::uint8_t {
   DeviceHeartbeatLost,    // the device heartbeat did not move for the watchdog time: disconnected
   TransportError,         // the socket or window reported an error
   TransportFull,          // the socket would block: the command was dropped
+  HostWatchdogTripped,    // the device's host watchdog tripped while this host ran (the host stalled
+                          // past the device's watchdog time): the device zeroed its force
 };
 
 enum class HapticLinkState : std::uint8_t {
@@ -93,7 +98,7 @@ struct [[nodiscard]] ReadResult {
 
 struct [[nodiscard]] WriteResult {
   WriteStatus status;
-  HapticFault reason;  // None when Written or Clamped
+  HapticFault reason;  // None when Written, Clamped or Held
 };
 
 // Rejected input, counted since construction. Never reset by the backend.
@@ -121,12 +126,17 @@ class HapticDevice {
   // The latest sample, if a new one arrived since the last call. Never blocks: a device that stopped
   // writing gives Stale (the counter did not move), and after the watchdog time without its heartbeat
   // moving, Fault / DeviceHeartbeatLost. `now_ns` drives that watchdog (monotonic). `out` is written
-  // only when the result is Fresh.
+  // only when the result is Fresh; it carries the device's status bits as the device set them.
+  // A device that reports its host watchdog tripped after it had confirmed it was armed for this
+  // backend (this host stalled) gives Fault / HostWatchdogTripped, once; one found tripped at the
+  // start (an earlier host's run) is re-armed by write_command, not reported.
   virtual ReadResult read_sample(MonotonicNs now_ns, HapticSample& out) = 0;
 
   // Sends one command and beats the host heartbeat (every call, whatever the command, unless the
   // result is Fault). Forces are clamped to the range; a command that is not finite sends zero force
-  // with enable off instead.
+  // with enable off instead. A device with a host watchdog drives nothing after a trip until it has
+  // seen enable off and then enable on; the backend therefore sends enable off (Held) until the device
+  // confirms it is armed, at the start and after a trip, and after a trip until clear_fault().
   virtual WriteResult write_command(const HapticCommand& command) = 0;
 
   [[nodiscard]] virtual HapticLinkState link_state() const = 0;

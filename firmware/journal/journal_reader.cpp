@@ -131,7 +131,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         const std::uint8_t read_status = body.u8();
         const std::uint8_t read_reason = body.u8();
         if (read_status > static_cast<std::uint8_t>(hal::ReadStatus::Fault) ||
-            read_reason > static_cast<std::uint8_t>(hal::HapticFault::TransportFull)) {
+            read_reason > static_cast<std::uint8_t>(hal::HapticFault::HostWatchdogTripped)) {
           result.error = at(offset) + "a cycle record's read status " + std::to_string(read_status) + " or reason " +
                          std::to_string(read_reason) + " is out of range";
           return result;

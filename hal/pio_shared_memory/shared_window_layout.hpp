@@ -30,7 +30,13 @@ namespace stencil::hal::pio_shared_memory {
 //  - the device (the real controller, and sim/haptic_device) zeroes its force when the host
 //    heartbeat has not moved for kHostWatchdogMs, sets haptic_status::kHostWatchdogTripped, and keeps
 //    the force at zero until the host has sent a command with enable off (re-arm) and then one with
-//    enable on, so a dead or restarted host can never leave force on the handle.
+//    enable on, so a dead or restarted host can never leave force on the handle. The trip outlives
+//    the host: a host that starts finds the device as the last one left it, perhaps tripped.
+//  - so the host sends enable off, whatever its caller asks, from its start (and again after a trip)
+//    until it has read kHostWatchdogTripped clear in a pose the device wrote after reading that
+//    enable off: two or more samples after the first pose the host read once it had written it. A
+//    trip reported after that is the host's own stall (its caller hears it); one found at its start
+//    is an earlier host's.
 //
 // Range rules. The host clamps force (magnitude) to the board's 5 N and torque to its limit before
 // writing, and never writes a non-finite value (it sends zero with enable off instead). The device

@@ -55,6 +55,14 @@ inline constexpr canid_t kStatusId = 0x182;
 inline constexpr canid_t kForceId = 0x100;
 inline constexpr canid_t kTorqueId = 0x101;
 
+// The frame set of one period, each side's frames in the order it sends them: what the bus must
+// carry every kFramePeriodNs (see can_bus_load.hpp), and what each side's socket receives.
+inline constexpr canid_t kDeviceFrameIds[] = {kPoseAId, kPoseBId, kStatusId};
+inline constexpr canid_t kHostFrameIds[] = {kForceId, kTorqueId};
+inline constexpr int kDeviceFramesPerPeriod = static_cast<int>(sizeof kDeviceFrameIds / sizeof kDeviceFrameIds[0]);
+inline constexpr int kHostFramesPerPeriod = static_cast<int>(sizeof kHostFrameIds / sizeof kHostFrameIds[0]);
+inline constexpr std::int64_t kFramePeriodNs = 1'000'000;  // both sides send once per 1 kHz cycle
+
 inline constexpr std::uint8_t kFrameBytes = 8;
 inline constexpr std::int32_t kInt24Min = -(1 << 23);
 inline constexpr std::int32_t kInt24Max = (1 << 23) - 1;

@@ -12,7 +12,13 @@
 #include <cstring>
 #include <vector>
 
+#include "hal/socketcan/can_error_frames.hpp"
+
 namespace stencil::hal::socketcan {
+
+namespace {
+constexpr int kMinimumReceiveBufferBytes = 128 * 1024;
+}  // namespace
 
 FdCanChannel::~FdCanChannel() {
   if (fd_ >= 0) ::close(fd_);
@@ -53,6 +59,18 @@ int open_can_raw_socket(const std::string& interface, const canid_t* receive_ids
     error = "CAN interface " + interface + ": socket(PF_CAN, SOCK_RAW, CAN_RAW): " + std::strerror(errno);
     return -1;
   }
+  // The backend's first read tells a backlog that overflowed the buffer from a short one by its size
+  // (socketcan_haptic_device.hpp): that needs a buffer that holds several reads' worth of frames. The
+  // default (rmem_default, 212992 bytes, about 277 frames) does; a host tuned below 128 KiB is raised
+  // to it (the kernel doubles what is asked: 64 KiB asked, 128 KiB given, over 128 frames at up to
+  // 1 KiB each), as far as net.core.rmem_max allows.
+  int receive_buffer_bytes = 0;
+  socklen_t option_length = sizeof receive_buffer_bytes;
+  if (::getsockopt(fd, SOL_SOCKET, SO_RCVBUF, &receive_buffer_bytes, &option_length) == 0 &&
+      receive_buffer_bytes < kMinimumReceiveBufferBytes) {
+    const int requested = kMinimumReceiveBufferBytes / 2;
+    static_cast<void>(::setsockopt(fd, SOL_SOCKET, SO_RCVBUF, &requested, sizeof requested));
+  }
   ifreq request{};
   std::memcpy(request.ifr_name, interface.c_str(), interface.size() + 1);
   if (::ioctl(fd, SIOCGIFINDEX, &request) != 0) {
@@ -67,6 +85,15 @@ int open_can_raw_socket(const std::string& interface, const canid_t* receive_ids
   if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FILTER, filters.data(),
                    static_cast<socklen_t>(filters.size() * sizeof(can_filter))) != 0) {
     error = "CAN interface " + interface + ": setsockopt(CAN_RAW_FILTER): " + std::strerror(errno);
+    ::close(fd);
+    return -1;
+  }
+  // Without this a bus-off, a controller that drops frames or a device gone from the bus would show
+  // only as poses that stop coming; with it the driver's error frames arrive among the data frames
+  // (CAN_ERR_FLAG set) and the backend stops the link naming what happened.
+  const can_err_mask_t error_classes = kSubscribedErrorClasses;
+  if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_ERR_FILTER, &error_classes, sizeof error_classes) != 0) {
+    error = "CAN interface " + interface + ": setsockopt(CAN_RAW_ERR_FILTER): " + std::strerror(errno);
     ::close(fd);
     return -1;
   }

@@ -30,8 +30,9 @@ class FdCanChannel final : public CanChannel {
 };
 
 // Opens a CAN_RAW socket on `interface` (e.g. "can0", "vcan0"), non-blocking, receiving only the
-// standard IDs in `receive_ids`. Init-time. Returns the descriptor, or -1 with `error` naming the
-// interface and the call that failed.
+// standard IDs in `receive_ids` and the error frames of kSubscribedErrorClasses (can_error_frames.hpp).
+// Init-time. It does not check the bitrate (can_interface_bitrate.hpp does). Returns the descriptor,
+// or -1 with `error` naming the interface and the call that failed.
 [[nodiscard]] int open_can_raw_socket(const std::string& interface, const canid_t* receive_ids, std::size_t id_count,
                                       std::string& error);
 

@@ -33,29 +33,119 @@ WriteResult SocketCanHapticDevice::write_fault(HapticFault reason) {
   return {WriteStatus::Fault, reason};
 }
 
+void SocketCanHapticDevice::take(TransferStatus received, const can_frame& frame, Drained& drained) {
+  if (received == TransferStatus::WrongSize) {
+    assembler_.count(FrameRejection::WrongSize);
+    drained.refused = FrameRejection::WrongSize;
+    return;
+  }
+  if (received != TransferStatus::Done) {
+    ++counters_.transport_errors;
+    state_ = HapticLinkState::Disconnected;
+    drained.fault = HapticFault::TransportError;
+    return;
+  }
+  if (is_error_frame(frame)) {
+    ++can_counters_.error_frames;
+    const CanBusError error = classify_error_frame(frame);
+    if (!stops_the_link(error)) return;  // recovered, or a single bus error: counted only
+    if (latched_fault_ == HapticFault::None) bus_error_ = error;
+    state_ = HapticLinkState::Disconnected;
+    status_since_bus_error_ = false;
+    drained.fault = HapticFault::TransportError;
+    return;
+  }
+  const FrameResult result = assembler_.accept(frame);
+  if (result.effect == FrameEffect::Completed) drained.new_pose = true;
+  if (result.effect == FrameEffect::Status) drained.status = true;
+  if (result.effect == FrameEffect::Rejected) drained.refused = result.rejection;
+}
+
+void SocketCanHapticDevice::drain_at_start(Drained& drained) {
+  first_read_done_ = true;
+  // Up to one ordinary read's frames, held back until it is known whether more wait behind them.
+  can_frame held[kMaxFramesPerRead];
+  TransferStatus held_status[kMaxFramesPerRead];
+  int count = 0;
+  bool more_waiting = true;
+  for (; count < kMaxFramesPerRead; ++count) {
+    held_status[count] = channel_->receive(held[count]);
+    if (held_status[count] == TransferStatus::WouldBlock) {
+      more_waiting = false;
+      break;
+    }
+    if (held_status[count] == TransferStatus::Closed || held_status[count] == TransferStatus::Error) {
+      take(held_status[count], held[count], drained);
+      return;
+    }
+  }
+  can_frame next{};
+  TransferStatus next_status = TransferStatus::WouldBlock;
+  if (more_waiting) {
+    next_status = channel_->receive(next);
+    more_waiting = next_status != TransferStatus::WouldBlock;
+  }
+  if (!more_waiting) {  // a few milliseconds' frames at most: as any read takes them
+    for (int index = 0; index < count && drained.fault == HapticFault::None; ++index) {
+      take(held_status[index], held[index], drained);
+    }
+    return;
+  }
+  // The link sat unread: a backlog, oldest first. Only its error frames count.
+  discarding_backlog_ = true;
+  for (int index = 0; index <= count && drained.fault == HapticFault::None; ++index) {
+    const TransferStatus status = index < count ? held_status[index] : next_status;
+    const can_frame& frame = index < count ? held[index] : next;
+    if (status == TransferStatus::Done && is_error_frame(frame)) {
+      take(status, frame, drained);
+    } else if (status == TransferStatus::Done || status == TransferStatus::WrongSize) {
+      ++can_counters_.frames_discarded_at_start;
+    } else {
+      take(status, frame, drained);
+    }
+  }
+  if (drained.fault == HapticFault::None) discard_backlog(drained);
+}
+
+void SocketCanHapticDevice::discard_backlog(Drained& drained) {
+  for (int frame_index = 0; frame_index < kMaxFramesDiscardedPerRead; ++frame_index) {
+    can_frame frame;
+    const TransferStatus received = channel_->receive(frame);
+    if (received == TransferStatus::WouldBlock) {
+      discarding_backlog_ = false;  // empty: what comes next was sent after the cycle started
+      return;
+    }
+    if (received == TransferStatus::Done && !is_error_frame(frame)) {
+      ++can_counters_.frames_discarded_at_start;
+      continue;
+    }
+    if (received == TransferStatus::WrongSize) {
+      ++can_counters_.frames_discarded_at_start;
+      continue;
+    }
+    take(received, frame, drained);
+    if (drained.fault != HapticFault::None) return;
+  }
+  // The bound: the rest waits for the next read, which carries on discarding.
+}
+
 ReadResult SocketCanHapticDevice::read_sample(MonotonicNs now_ns, HapticSample& out) {
   if (channel_ == nullptr) return read_fault(HapticFault::NotOpen);
 
-  bool new_pose = false;
-  FrameRejection refused = FrameRejection::None;
-  for (int frame_index = 0; frame_index < kMaxFramesPerRead; ++frame_index) {
-    can_frame frame;
-    const TransferStatus received = channel_->receive(frame);
-    if (received == TransferStatus::WouldBlock) break;
-    if (received == TransferStatus::WrongSize) {
-      assembler_.count(FrameRejection::WrongSize);
-      refused = FrameRejection::WrongSize;
-      continue;
+  Drained drained;
+  if (discarding_backlog_) {
+    discard_backlog(drained);
+  } else if (!first_read_done_) {
+    drain_at_start(drained);
+  } else {
+    for (int frame_index = 0; frame_index < kMaxFramesPerRead && drained.fault == HapticFault::None; ++frame_index) {
+      can_frame frame;
+      const TransferStatus received = channel_->receive(frame);
+      if (received == TransferStatus::WouldBlock) break;
+      take(received, frame, drained);
     }
-    if (received != TransferStatus::Done) {
-      ++counters_.transport_errors;
-      state_ = HapticLinkState::Disconnected;
-      return read_fault(HapticFault::TransportError);
-    }
-    const FrameResult result = assembler_.accept(frame);
-    if (result.effect == FrameEffect::Completed) new_pose = true;
-    if (result.effect == FrameEffect::Rejected) refused = result.rejection;
   }
+  if (drained.fault != HapticFault::None) return read_fault(drained.fault);
 
   // The device heartbeat comes with the Status frame; none yet counts as a heartbeat that never moved.
   const std::uint32_t heartbeat = assembler_.has_status() ? assembler_.latest_status().device_heartbeat : 0U;
@@ -63,12 +153,13 @@ ReadResult SocketCanHapticDevice::read_sample(MonotonicNs now_ns, HapticSample& 
     state_ = HapticLinkState::Disconnected;
     return read_fault(HapticFault::DeviceHeartbeatLost);
   }
-  if (assembler_.has_status()) state_ = HapticLinkState::Connected;
+  if (drained.status) status_since_bus_error_ = true;
+  if (assembler_.has_status() && status_since_bus_error_) state_ = HapticLinkState::Connected;
 
-  if (!new_pose) {
-    if (refused != FrameRejection::None) {
-      return {ReadStatus::Rejected,
-              refused == FrameRejection::OutOfRange ? HapticFault::SampleOutOfRange : HapticFault::BadFrame};
+  if (!drained.new_pose) {
+    if (drained.refused != FrameRejection::None) {
+      return {ReadStatus::Rejected, drained.refused == FrameRejection::OutOfRange ? HapticFault::SampleOutOfRange
+                                                                                  : HapticFault::BadFrame};
     }
     ++counters_.stale_reads;
     return {ReadStatus::Stale, HapticFault::None};

@@ -11,7 +11,8 @@ namespace stencil::sim {
 
 class CanDeviceLink final : public DeviceSideLink {
  public:
-  // The channel must outlive this object.
+  // The channel must outlive this object: one end of a socket pair (every frame arrives at once), the
+  // device() node of a SimulatedCanBus (frames take wire time, queues are bounded), or a CAN_RAW socket.
   explicit CanDeviceLink(hal::socketcan::CanChannel& channel) : channel_(channel) {}
 
   // Sends PoseA, PoseB and Status (a full queue drops frames, counted).

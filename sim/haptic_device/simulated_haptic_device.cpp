@@ -56,7 +56,10 @@ void SimulatedHapticDevice::step(hal::MonotonicNs now_ns) {
     output_.watchdog_tripped = true;
     ++output_.watchdog_trips;
   }
-  // Re-arming: the host, beating again, first sends enable off; its next enable on drives force.
+  // Re-arming: the host, beating again, first sends enable off; its next enable on drives force (the
+  // window's contract, hal/pio_shared_memory/shared_window_layout.hpp, Heartbeats; the same on CAN).
+  // The trip is this device's state, not the host's: a host that ends and a new one that opens the
+  // same window or bus find it still tripped, and the new one must re-arm it like any other.
   if (output_.watchdog_tripped && !host_watchdog_.expired(now_ns) && have_command_ && !command_.enable) {
     output_.watchdog_tripped = false;
   }

@@ -13,13 +13,14 @@ inline SimpleString StringFrom(ReadStatus status) {
   return kNames[static_cast<int>(status)];
 }
 inline SimpleString StringFrom(WriteStatus status) {
-  constexpr const char* kNames[] = {"Written", "Clamped", "Rejected", "Fault"};
+  constexpr const char* kNames[] = {"Written", "Clamped", "Rejected", "Fault", "Held"};
   return kNames[static_cast<int>(status)];
 }
 inline SimpleString StringFrom(HapticFault fault) {
   constexpr const char* kNames[] = {"None",          "NotOpen",          "SampleBusy",
                                     "SampleOutOfRange", "SampleNotFinite", "BadFrame",      "CommandNotFinite",
-                                    "DeviceHeartbeatLost", "TransportError", "TransportFull"};
+                                    "DeviceHeartbeatLost", "TransportError", "TransportFull",
+                                    "HostWatchdogTripped"};
   return kNames[static_cast<int>(fault)];
 }
 inline SimpleString StringFrom(HapticLinkState state) {

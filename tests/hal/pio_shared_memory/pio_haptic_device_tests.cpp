@@ -1,5 +1,6 @@
 // The PIO shared memory backend: the window's header check, seqlock reads that never accept a torn
-// sample, stale and frozen devices, range rules on both sides, and the time of one cycle.
+// sample, stale and frozen devices, range rules on both sides, arming the device's host watchdog (a
+// restarted host, a trip during the run), and the time of one cycle.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -95,6 +96,29 @@ TEST_GROUP(PioHapticDevice) {
     device_link = std::make_unique<sim::PioDeviceLink>(windows.device->window());
     device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, counter_pose);
     test::open_host_window(windows);
+    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
+  }
+
+  // One millisecond as the rig runs it: the device's cycle, then the host's (read, then write).
+  hal::WriteResult cycle(int ms, const hal::HapticCommand& command) {
+    device->step(ms * kMs);
+    hal::HapticSample sample{};
+    static_cast<void>(host->read_sample(ms * kMs, sample));
+    return host->write_command(command);
+  }
+
+  // Cycles first_ms..last_ms with enable off: long enough for the host to arm the device (four).
+  void arm_the_device(int first_ms, int last_ms) {
+    for (int ms = first_ms; ms <= last_ms; ++ms) {
+      CHECK_EQUAL(WriteStatus::Written, cycle(ms, command_of(0.0, 0.0, 0.0, false)).status);
+    }
+  }
+
+  // A new host program on the same window, as a restarted stencil-rig maps the card again.
+  void restart_the_host() {
+    host.reset();
+    test::open_host_window(windows);
+    CHECK_TRUE(windows.host != nullptr);
     host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
   }
 };
@@ -218,6 +242,7 @@ TEST(PioHapticDevice, RefusesAPoseBeyondTheDevicesReach) {
 }
 
 TEST(PioHapticDevice, ClampsForceAndTorqueToTheirLimitsBeforeWriting) {
+  arm_the_device(1, 5);
   hal::HapticCommand command = command_of(6.0, 8.0, 0.0);  // 10 N
   command.torque_nmm[0] = 300.0;
   command.torque_nmm[1] = -400.0;  // 500 N.mm
@@ -239,13 +264,14 @@ TEST(PioHapticDevice, ClampsForceAndTorqueToTheirLimitsBeforeWriting) {
   pio::load_fields(windows.device->window().command, words);
   CHECK_TRUE(pio::command_within_device_limits(words));
 
-  device->step(1 * kMs);
+  device->step(6 * kMs);
   const sim::DeviceOutput output = device->output();
   CHECK_TRUE(output.force_applied);
   DOUBLES_EQUAL(5.0 / std::sqrt(3.0), output.force_n[0], 1e-3);
 }
 
 TEST(PioHapticDevice, SendsZeroForceWithEnableOffForANonFiniteCommand) {
+  arm_the_device(1, 5);
   CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(1.0, 0.0, 0.0)).status);
   const std::uint32_t heartbeat_before = windows.device->window().command.host_heartbeat;
   hal::HapticCommand command = command_of(1.0, std::nan(""), 0.0);
@@ -289,9 +315,10 @@ TEST(PioHapticDevice, TheDeviceRefusesACommandBeyondItsOwnLimits) {
   CHECK_EQUAL(2U, device_link->counters().commands_out_of_range);
   CHECK_FALSE(device->output().force_applied);
 
-  // A proper command is driven.
+  // A proper command from the host, once it has armed the device, is driven.
+  arm_the_device(3, 7);
   CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 2.5)).status);
-  device->step(3 * kMs);
+  device->step(8 * kMs);
   output = device->output();
   CHECK_TRUE(output.force_applied);
   DOUBLES_EQUAL(2.5, output.force_n[2], 1e-9);
@@ -305,6 +332,153 @@ TEST(PioHapticDevice, TheHostHeartbeatMovesWithEveryWriteAndContinuesAfterAResta
   pio::PioHapticDevice restarted(&windows.host->window(), hal::kDefaultHapticRange);
   CHECK_EQUAL(WriteStatus::Written, restarted.write_command(command_of(0.0, 0.0, 0.0, false)).status);
   CHECK_EQUAL(4U, windows.device->window().command.host_heartbeat);
+}
+
+// Issue 18 item 5: a host that starts while the device's host watchdog is still tripped from an
+// earlier run (the previous stencil-rig died or was killed) must re-arm it with enable off before
+// its enable on can drive anything; a host that sends enable on from its first cycle gets no force
+// on any run after the first.
+TEST(PioHapticDevice, ARestartedHostGetsForceThroughOnceItHasReArmedTheTrippedDevice) {
+  // The first run pushes 2 N; then its program dies and the device trips 20 ms later.
+  for (int ms = 1; ms <= 10; ++ms) CHECK_TRUE(cycle(ms, command_of(0.0, 0.0, 2.0)).status != WriteStatus::Fault);
+  CHECK_TRUE(device->output().force_applied);
+  for (int ms = 11; ms <= 40; ++ms) device->step(ms * kMs);
+  CHECK_TRUE(device->output().watchdog_tripped);
+
+  // The next run asks for force from its first cycle, as the controller does.
+  restart_the_host();
+  int first_force_ms = 0;
+  bool saw_the_tripped_bit = false;
+  for (int ms = 41; ms <= 200 && first_force_ms == 0; ++ms) {
+    device->step(ms * kMs);
+    if (device->output().force_applied) first_force_ms = ms;
+    hal::HapticSample sample{};
+    const hal::ReadResult read = host->read_sample(ms * kMs, sample);
+    CHECK_EQUAL(ReadStatus::Fresh, read.status);  // the earlier run's trip is shown, not this run's fault
+    saw_the_tripped_bit = saw_the_tripped_bit || (sample.status_bits & hal::haptic_status::kHostWatchdogTripped) != 0U;
+    CHECK_TRUE(host->write_command(command_of(0.0, 0.0, 2.0)).status != WriteStatus::Fault);
+  }
+  CHECK_TRUE(saw_the_tripped_bit);
+  CHECK_TEXT(first_force_ms != 0, "the device drove no force in the 160 ms after the host restarted");
+  CHECK_TEXT(first_force_ms <= 41 + 4, "force came later than four device cycles after the restart");
+  const sim::DeviceOutput output = device->output();
+  DOUBLES_EQUAL(2.0, output.force_n[2], 1e-9);
+  CHECK_FALSE(output.watchdog_tripped);
+  CHECK_EQUAL(1U, output.watchdog_trips);
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+}
+
+TEST(PioHapticDevice, AHostStartingAgainstAnUntrippedDeviceDrivesForceWithinAFewCycles) {
+  int first_force_ms = 0;
+  for (int ms = 1; ms <= 20; ++ms) {
+    device->step(ms * kMs);
+    if (first_force_ms == 0 && device->output().force_applied) first_force_ms = ms;
+    hal::HapticSample sample{};
+    const hal::ReadResult read = host->read_sample(ms * kMs, sample);
+    CHECK_TRUE(read.status == ReadStatus::Fresh);
+    CHECK_EQUAL(0U, sample.status_bits & hal::haptic_status::kHostWatchdogTripped);
+    CHECK_TRUE(host->write_command(command_of(0.0, 0.0, 2.0)).status != WriteStatus::Fault);
+  }
+  CHECK_TEXT(first_force_ms != 0 && first_force_ms <= 5, "force did not come within five device cycles");
+  const sim::DeviceOutput output = device->output();
+  CHECK_TRUE(output.force_applied);
+  DOUBLES_EQUAL(2.0, output.force_n[2], 1e-9);
+  CHECK_EQUAL(0U, output.watchdog_trips);
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+}
+
+TEST(PioHapticDevice, HoldsEnableOffUntilTheDeviceConfirmsItIsArmedWhateverTheCallerAsks) {
+  const pio::CommandBlock& block = windows.device->window().command;
+  // Before the device has written anything: enable on is held, and nothing of the force goes out.
+  const hal::WriteResult first = host->write_command(command_of(0.0, 0.0, 2.0));
+  CHECK_EQUAL(WriteStatus::Held, first.status);
+  CHECK_EQUAL(HapticFault::None, first.reason);
+  CHECK_EQUAL(0U, block.flags);
+  CHECK_EQUAL(0, block.force_mn[2]);
+  CHECK_EQUAL(1U, block.host_heartbeat);  // it still beats
+  // Enable off is sent as given.
+  CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 0.0, false)).status);
+
+  // The device's samples say its watchdog is clear; the host trusts only one the device wrote after
+  // it read the enable off (two samples on from the first pose read after it), then lets enable on through.
+  int held = 0;
+  for (int ms = 1; ms <= 10; ++ms) {
+    const hal::WriteResult result = cycle(ms, command_of(0.0, 0.0, 2.0));
+    if (result.status == WriteStatus::Held) {
+      ++held;
+      CHECK_EQUAL(0U, block.flags);
+      CHECK_EQUAL(0, block.force_mn[2]);
+    } else {
+      CHECK_EQUAL(WriteStatus::Written, result.status);  // and never held again once armed
+      CHECK_EQUAL(pio::kCommandEnableBit, block.flags);
+      CHECK_EQUAL(2000, block.force_mn[2]);
+    }
+  }
+  CHECK_EQUAL(2, held);  // ms 1 reads pose 1 (the first after the enable off), ms 3 reads pose 3: armed
+  CHECK_TRUE(device->output().force_applied);
+}
+
+// A trip during the run means this host stalled past the device's 20 ms: the caller hears it once, as
+// a fault with its own reason, and no force comes back until the caller has cleared it.
+TEST(PioHapticDevice, ReportsATripDuringTheRunAsAFaultAndHoldsForceUntilTheCallerClearsIt) {
+  for (int ms = 1; ms <= 10; ++ms) CHECK_TRUE(cycle(ms, command_of(0.0, 0.0, 2.0)).status != WriteStatus::Fault);
+  CHECK_TRUE(device->output().force_applied);
+
+  // The host stalls for 25 ms: the device trips.
+  for (int ms = 11; ms <= 35; ++ms) device->step(ms * kMs);
+  CHECK_TRUE(device->output().watchdog_tripped);
+  hal::HapticSample sample = marker_sample();
+  const hal::ReadResult tripped = host->read_sample(35 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, tripped.status);
+  CHECK_EQUAL(HapticFault::HostWatchdogTripped, tripped.reason);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);  // untouched
+  CHECK_EQUAL(HapticFault::HostWatchdogTripped, host->latched_fault());
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());  // the device itself is fine
+
+  // A caller that carries on asking for force gets none: enable off goes out (re-arming the device)
+  // for as long as the trip is latched; the samples come as usual, the bit in them until re-armed.
+  for (int ms = 36; ms <= 45; ++ms) {
+    device->step(ms * kMs);
+    CHECK_FALSE(device->output().force_applied);
+    const hal::ReadResult read = host->read_sample(ms * kMs, sample);
+    CHECK_EQUAL(ReadStatus::Fresh, read.status);
+    CHECK_EQUAL(WriteStatus::Held, host->write_command(command_of(0.0, 0.0, 2.0)).status);
+  }
+  CHECK_FALSE(device->output().watchdog_tripped);
+  CHECK_EQUAL(0U, sample.status_bits & hal::haptic_status::kHostWatchdogTripped);
+  CHECK_EQUAL(HapticFault::HostWatchdogTripped, host->latched_fault());
+
+  host->clear_fault();
+  CHECK_EQUAL(WriteStatus::Written, cycle(46, command_of(0.0, 0.0, 2.0)).status);
+  device->step(47 * kMs);
+  CHECK_TRUE(device->output().force_applied);
+  DOUBLES_EQUAL(2.0, device->output().force_n[2], 1e-9);
+  CHECK_EQUAL(1U, device->output().watchdog_trips);
+}
+
+TEST(PioHapticDevice, AfterATripForceWaitsForClearFaultEvenWhenTheLatchHoldsAnEarlierFault) {
+  for (int ms = 1; ms <= 10; ++ms) CHECK_TRUE(cycle(ms, command_of(0.0, 0.0, 2.0)).status != WriteStatus::Fault);
+  CHECK_TRUE(device->output().force_applied);
+  // The whole box stalls: the device's controller and the host. The host, first back, finds the
+  // device heartbeat frozen; then the device comes back and trips on the host's frozen heartbeat.
+  device->step(11 * kMs);  // it took the host's last command
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(11 * kMs, sample).status);
+  device->set_frozen(true);
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->read_sample(70 * kMs, sample).reason);
+  device->set_frozen(false);
+  device->step(71 * kMs);
+  const hal::ReadResult tripped = host->read_sample(71 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, tripped.status);
+  CHECK_EQUAL(HapticFault::HostWatchdogTripped, tripped.reason);
+  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());  // the first reason stays
+
+  for (int ms = 72; ms <= 80; ++ms) CHECK_EQUAL(WriteStatus::Held, cycle(ms, command_of(0.0, 0.0, 2.0)).status);
+  CHECK_FALSE(device->output().watchdog_tripped);
+  host->clear_fault();
+  CHECK_EQUAL(WriteStatus::Written, cycle(81, command_of(0.0, 0.0, 2.0)).status);
+  device->step(82 * kMs);
+  CHECK_TRUE(device->output().force_applied);
 }
 
 TEST(PioHapticDevice, ABackendWithoutAWindowReportsNotOpenAndLatchesIt) {

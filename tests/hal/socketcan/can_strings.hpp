@@ -5,6 +5,7 @@
 
 #include "hal/socketcan/can_channel.hpp"
 #include "hal/socketcan/can_codec.hpp"
+#include "hal/socketcan/can_error_frames.hpp"
 
 namespace stencil::hal::socketcan {
 
@@ -20,6 +21,14 @@ inline SimpleString StringFrom(FrameEffect effect) {
 inline SimpleString StringFrom(TransferStatus status) {
   constexpr const char* kNames[] = {"Done", "WouldBlock", "WrongSize", "Closed", "Error"};
   return kNames[static_cast<int>(status)];
+}
+
+inline SimpleString StringFrom(CanBusError error) {
+  constexpr const char* kNames[] = {"None",         "BusOff",       "Restarted",         "NoAcknowledge",
+                                    "TransmitTimeout", "ControllerOverflow", "ErrorPassive", "ErrorWarning",
+                                    "ControllerProblem", "BackToErrorActive", "Other"};
+  static_assert(sizeof kNames / sizeof kNames[0] == kCanBusErrorKinds);
+  return kNames[static_cast<int>(error)];
 }
 
 }  // namespace stencil::hal::socketcan

@@ -12,6 +12,9 @@
 #include <string>
 #include <vector>
 
+#include <linux/can/error.h>
+
+#include "hal/socketcan/can_error_frames.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
 #include "sim/haptic_device/can_device_link.hpp"
@@ -174,6 +177,89 @@ TEST(SocketCanHapticDevice, BadFramesOnTheWireAreRefusedCountedAndNeverApplied) 
   CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(4 * kMs, sample).status);
   CHECK_EQUAL(applied.sample_counter + 1, sample.sample_counter);
   CHECK_TRUE(test::consistent_with_counter(sample));
+}
+
+TEST(SocketCanHapticDevice, ABusOffErrorFrameIsALatchedLinkFaultNamedBusOff) {
+  device->step(1 * kMs);
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
+  inject(can::make_error_frame(CAN_ERR_BUSOFF));  // what the controller's driver reports
+  device->step(2 * kMs);
+
+  sample = marker_sample();
+  const hal::ReadResult off = host->read_sample(2 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, off.status);
+  CHECK_EQUAL(HapticFault::TransportError, off.reason);
+  CHECK_EQUAL(0xDEADU, sample.sample_counter);
+  CHECK_EQUAL(HapticFault::TransportError, host->latched_fault());
+  CHECK_EQUAL(can::CanBusError::BusOff, host->bus_error());
+  STRCMP_EQUAL("bus-off", can::can_bus_error_name(host->bus_error()));
+  CHECK_EQUAL(hal::HapticLinkState::Disconnected, host->link_state());
+  CHECK_EQUAL(1U, host->can_counters().error_frames);
+  CHECK_EQUAL(0U, host->counters().bad_frames);  // an error frame is not a bad data frame
+
+  // The bus came back: frames are read again, but the latch holds until the cycle clears it.
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(2 * kMs, sample).status);
+  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
+  CHECK_EQUAL(HapticFault::TransportError, host->latched_fault());
+  CHECK_EQUAL(can::CanBusError::BusOff, host->bus_error());
+  host->clear_fault();
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+  CHECK_EQUAL(can::CanBusError::None, host->bus_error());
+}
+
+TEST(SocketCanHapticDevice, AControllerThatLostFramesIsALinkFaultNamingTheOverflow) {
+  inject(can::make_error_frame(CAN_ERR_CRTL, CAN_ERR_CRTL_RX_OVERFLOW));
+  hal::HapticSample sample{};
+  const hal::ReadResult lost = host->read_sample(1 * kMs, sample);
+  CHECK_EQUAL(ReadStatus::Fault, lost.status);
+  CHECK_EQUAL(HapticFault::TransportError, lost.reason);
+  CHECK_EQUAL(can::CanBusError::ControllerOverflow, host->bus_error());
+  // A later error keeps the first reason, like every latch.
+  inject(can::make_error_frame(CAN_ERR_BUSOFF));
+  CHECK_EQUAL(ReadStatus::Fault, host->read_sample(2 * kMs, sample).status);
+  CHECK_EQUAL(can::CanBusError::ControllerOverflow, host->bus_error());
+  CHECK_EQUAL(2U, host->can_counters().error_frames);
+}
+
+TEST(SocketCanHapticDevice, AControllerBackToErrorActiveIsCountedAndIsNoFault) {
+  device->step(1 * kMs);
+  inject(can::make_error_frame(CAN_ERR_CRTL, CAN_ERR_CRTL_ACTIVE));
+  hal::HapticSample sample{};
+  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
+  CHECK_EQUAL(HapticFault::None, host->latched_fault());
+  CHECK_EQUAL(can::CanBusError::None, host->bus_error());
+  CHECK_EQUAL(1U, host->can_counters().error_frames);
+}
+
+TEST(SocketCanHapticDevice, FramesQueuedWhileTheLinkSatUnreadAreNeverTheFirstPose) {
+  // Homing: the socket is open, nobody reads it, the device sends every millisecond. Its queue fills
+  // and then, as the kernel does, the newest frames are dropped: what waits is the oldest.
+  constexpr int kHomingMs = 3000;
+  for (int ms = 1; ms <= kHomingMs; ++ms) device->step(ms * kMs);
+  CHECK_TRUE(device_link->frames_dropped() > 0);
+
+  // The cycle starts. The first pose it is given must be the device's newest, within the controller's
+  // five stale periods.
+  int ms = kHomingMs;
+  hal::HapticSample sample = marker_sample();
+  ReadStatus status = host->read_sample(ms * kMs, sample).status;
+  int reads = 1;
+  while (status != ReadStatus::Fresh && reads < 5) {
+    ++ms;
+    device->step(ms * kMs);
+    status = host->read_sample(ms * kMs, sample).status;
+    ++reads;
+  }
+  CHECK_EQUAL(ReadStatus::Fresh, status);
+  // The device's heartbeat carries all 32 bits of its cycle count (the pose's counter only 8).
+  CHECK_EQUAL(static_cast<std::uint32_t>(ms), sample.device_heartbeat);
+  const sim::SimulatedPose newest = test::counter_pose(static_cast<std::uint32_t>(ms), 0);
+  DOUBLES_EQUAL(newest.position_mm[0], sample.position_mm[0], 1e-9);
+  DOUBLES_EQUAL(newest.position_mm[2], sample.position_mm[2], 1e-9);
+  CHECK_TRUE(reads <= 3);
+  CHECK_TRUE(host->can_counters().frames_discarded_at_start > 100);
+  CHECK_EQUAL(0U, host->counters().bad_frames);
 }
 
 TEST(SocketCanHapticDevice, CommandsReachTheDeviceClampedAndQuantised) {
