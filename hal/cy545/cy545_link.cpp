@@ -253,7 +253,8 @@ bool Cy545Link::select_channel(std::uint8_t channel, MonotonicNs deadline_ns) {
     return true;
   }
   if (motor_line_on_ != channel) {
-    if (motor_line_on_ >= 0 && !latch_motor_line(static_cast<std::uint8_t>(motor_line_on_), false, deadline_ns)) {
+    if (config_.channel_lines_latch_data && motor_line_on_ >= 0 &&
+        !latch_motor_line(static_cast<std::uint8_t>(motor_line_on_), false, deadline_ns)) {
       return false;
     }
     motor_line_on_ = -1;

@@ -73,6 +73,12 @@ struct Cy545Config {
   // The watchdog relay's heartbeat: a general-purpose output toggled every heartbeat_period_ns / 2
   // while the machine side runs (homing included); -1: none (a rig without the relay).
   int heartbeat_output = 5;
+  // How the MMC-4S latches a motor channel (its manual is not at hand): true, each line latches its
+  // data bit, so the old channel's line is latched off before the new one's on (right under either
+  // reading, at six commands a change of axis instead of three); false, the board latches the
+  // address (the thesis's table 5-1: output ports 0-3 are "motor/driver addresses"), one select.
+  // Measure it at commissioning: select X, then Y, step, and see whether X moves.
+  bool channel_lines_latch_data = true;
   MonotonicNs heartbeat_period_ns = 400'000'000;  // the relay drops after about 1 s without a change
 };
 
