@@ -59,6 +59,7 @@ TEST(MillChain, TheMillFollowsTheVirtualToolRoundTheHexPrismThroughTheRealDriver
   hal::cy545::Cy545Config config;
   config.homing_rate = 20000;
   config.homing_slow_rate = 5000;
+  config.reply_timeout_ns = 250 * kMs;  // the fake is a thread on a host that is not real-time
   config.homing_travel_steps = 2000;
   hal::cy545::Cy545Link link(port, clock, config);
   sim::cy545::FakeCy545Runner runner{fake};
