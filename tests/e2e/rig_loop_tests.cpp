@@ -75,7 +75,9 @@ struct FakeRig {
     window = hal::pio_shared_memory::SharedWindowMapping::create_memfd("rig-loop-tests", error);
     CHECK(window != nullptr);
     device_link = std::make_unique<sim::PioDeviceLink>(window->window());
-    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, pose);
+    // The device trips after 200 ms of a frozen host heartbeat, not the card's 20: the host cycle here
+    // is a thread on a host that is not real-time (as stale_periods and overrun_limit below).
+    device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, pose, 200'000'000);
     host = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
     device->step(sim::cy545::FakeCy545Runner::monotonic_now_ns());
     device_thread = std::thread([this] {
