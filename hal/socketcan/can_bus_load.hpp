@@ -53,8 +53,8 @@ struct StuffedBits {
   }
   constexpr void put_with_crc(bool bit) {
     const bool feedback = bit != (((crc >> 14U) & 1U) != 0U);
-    crc = static_cast<std::uint16_t>((crc << 1U) & 0x7FFFU);
-    if (feedback) crc = static_cast<std::uint16_t>(crc ^ 0x4599U);
+    crc = static_cast<std::uint16_t>((static_cast<std::uint32_t>(crc) << 1U) & 0x7FFFU);
+    if (feedback) crc = static_cast<std::uint16_t>(static_cast<std::uint32_t>(crc) ^ 0x4599U);
     put(bit);
   }
   constexpr void put_field_with_crc(std::uint32_t value, int bits) {
