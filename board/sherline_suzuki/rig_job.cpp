@@ -126,6 +126,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
   std::atomic<control::SafeReason> first_fault{control::SafeReason::None};
   std::atomic<bool> stop_asked{false};
   std::thread machine_thread([&] {
+    if (job.prepare_machine_thread) {
+      job.prepare_machine_thread();  // its priority: below the cycle, above the records thread
+    }
     hal::MonotonicNs next = clock.now_ns();
     bool stop_reported = false;
     while (!stop.load()) {
@@ -194,7 +197,9 @@ RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
         job.progress(line);
         next_progress += std::chrono::seconds(1);
       }
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      // Or less: a target the machine thread queued wakes this thread, which writes it at once, so
+      // the machine side sends it at its next update.
+      records.wait(std::chrono::milliseconds(50));
     }
   });
 

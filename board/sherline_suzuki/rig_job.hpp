@@ -72,6 +72,9 @@ struct RigJob {
   std::function<bool()> confirm_spindle;
   // Polled by the records thread: true when the operator asks for a reset (typed at the terminal).
   std::function<bool()> reset_requested;
+  // Run first on the machine thread, before its first update: stencil-rig gives it SCHED_FIFO below
+  // the cycle and above the records thread (app::run_this_thread_fifo); none in the tests.
+  std::function<void()> prepare_machine_thread;
   // An operator display (--hmi): fed by the records and machine threads, never the cycle; its
   // requests (parameters, reset) go into the command ring from the records thread.
   control::DisplayFeed* display = nullptr;

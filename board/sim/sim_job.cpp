@@ -55,6 +55,9 @@ constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
 // an update that takes longer than a period only makes the mill fall behind (the backlog slows the
 // virtual tool), never a fault.
 constexpr hal::MonotonicNs kUpdateBoundNs = 3 * kUpdateNs;
+// The simulated rig's hardware watchdog relay: it opens when the heartbeat output has not changed
+// for this long (the driver toggles it every 200 ms).
+constexpr hal::MonotonicNs kWatchdogRelayNs = 1'000'000'000;
 constexpr double kBaud = 57600.0;
 constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
 
@@ -382,7 +385,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   fake.board().set_channel_latching(stencil::sim::cy545::ChannelLatching::Address);
   fake.chip().set_command_time_ns(0);  // see link_config.command_settle_ns
   // The rig's hardware watchdog relay on the heartbeat output (Cy545Config::heartbeat_output).
-  fake.board().arm_watchdog_relay(5, 1'000'000'000, epoch_ns);
+  fake.board().arm_watchdog_relay(5, kWatchdogRelayNs, epoch_ns);
   stencil::sim::MachinedPart machined{part, job.stock, frames, [&fake, epoch_ns] {
                                         return static_cast<double>(fake.chip().now_ns() - epoch_ns) / 1e9;
                                       }};
@@ -451,15 +454,35 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
   }
   const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
   auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, rings->machine, rings->machine_events);
+  // At the end, once the machine side has stopped the mill: its power as the board's latches leave
+  // it, then a second later, when the watchdog relay (armed above) has dropped what the driver could
+  // not turn off because its heartbeat stopped with the job. What the machinist finds at the mill.
+  const auto leave_the_mill = [&](hal::MonotonicNs now_ns) {
+    result.machine_stop_confirmed = machine->stop_confirmed();
+    result.mill_spindle_on_after_stop = mill.spindle_on();
+    result.mill_drivers_on_after_stop = mill.drivers_enabled();
+    fake.board().advance_to(now_ns + kWatchdogRelayNs + 1'000'000);
+    result.mill_relay_dropped_power = !fake.board().watchdog_relay_closed() &&
+                                      (result.mill_spindle_on_after_stop || result.mill_drivers_on_after_stop);
+    result.mill_on_after_relay = mill.spindle_on() || mill.drivers_enabled();
+  };
   // The controller's own model of the stock, from the targets it sends (cells allocated here, once).
   const control::StockBlock block{job.stock.low_mm, job.stock.high_mm};
   std::vector<float> model_cells(control::CommandedStock::cells_needed(block, kModelCellMm));
   control::CommandedStock model(block, kModelCellMm, part.tool.spec, model_cells);
   machine->keep_stock_model(&model);
+  // Every target is in the journal before it is sent. In real time the machine thread queues it for
+  // the records thread, which writes it at once, and sends it when written (it never waits on the
+  // journal's lock or disk); on virtual time one thread runs both and writes it through itself, so
+  // it goes out in the same update (the same report and journal as ever).
   std::unique_ptr<journal::MachineJournal> machine_journal;
-  if (job.journal != nullptr) {
+  std::unique_ptr<journal::InlineMachineJournal> inline_machine_journal;
+  if (job.journal != nullptr && realtime) {
     machine_journal = std::make_unique<journal::MachineJournal>(*job.journal);
     machine->record_to(machine_journal.get());
+  } else if (job.journal != nullptr) {
+    inline_machine_journal = std::make_unique<journal::InlineMachineJournal>(*job.journal);
+    machine->record_to(inline_machine_journal.get());
   }
   // A resumed job: what was touched and machined before, from the journal, before the machine homes.
   if (!job.resume_from.empty()) {
@@ -542,7 +565,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
         if (job.interrupted != nullptr && job.interrupted->load()) {
           static_cast<void>(rings->commands.push({control::CommandKind::Stop}));
         }
-        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        records.wait(std::chrono::milliseconds(50));  // or less: a target queued is written at once
       }
     });
     double next_progress_s = 10.0;
@@ -585,7 +608,9 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     machine_thread.join();
     records_thread.join();
     records.drain(rings->journal);  // the last records, left after the records thread's last look
+    machine->shut_down(machine_clock.now_ns() + kUpdateBoundNs);  // while the fake still answers
     fake_runner.reset();
+    leave_the_mill(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns());
     if (!ran) {
       result.started = false;
       result.error = runner_error;
@@ -729,6 +754,8 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     }
   }
   records.drain(rings->journal);
+  machine->shut_down(machine_clock.now_ns() + kUpdateBoundNs);
+  leave_the_mill(machine_clock.now_ns());
   machined.flush();
   return finish_result(result, part, *controller, *machine, model, machined, link, compute,
                        static_cast<double>(cycle_ns - start_ns) / 1e9, wall_start, mill, false);

@@ -132,6 +132,14 @@ struct SimResult {
   double machine_max_lag_mm = 0.0;
   control::SafeReason safe_state = control::SafeReason::None;
   std::string machine_error;  // the machine link's last error, when it faulted
+  // At the end: did the link confirm spindle and drivers off; the simulated mill's power once the
+  // machine side stopped it (the board's latches); whether the watchdog relay had to drop it a
+  // second later (the heartbeat stopped with the job); and whether anything is on even then.
+  bool machine_stop_confirmed = false;
+  bool mill_spindle_on_after_stop = false;
+  bool mill_drivers_on_after_stop = false;
+  bool mill_relay_dropped_power = false;
+  bool mill_on_after_relay = false;
   bool complete = false;  // until_complete met
   // The injected fault and what followed, simulated seconds (negative: never happened).
   FaultKind fault_kind = FaultKind::None;

@@ -105,6 +105,11 @@ bool write_report_json(const std::string& path, const SimResult& r, std::string&
       {"max_force_n", r.max_force_n},
       {"max_offset_mm", r.max_offset_mm},
       {"machine", {{"updates", r.machine_updates}, {"take_ups", r.machine_take_ups}, {"max_lag_mm", r.machine_max_lag_mm},
+                   {"stop_confirmed", r.machine_stop_confirmed},
+                   {"spindle_on_after_stop", r.mill_spindle_on_after_stop},
+                   {"drivers_on_after_stop", r.mill_drivers_on_after_stop},
+                   {"watchdog_relay_dropped_power", r.mill_relay_dropped_power},
+                   {"on_after_watchdog_relay", r.mill_on_after_relay},
                    {"error", r.machine_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.machine_error)}}},
       {"safe_state", r.safe_state == control::SafeReason::None ? nlohmann::json(nullptr)
                                                                 : nlohmann::json(control::safe_reason_name(r.safe_state))},
@@ -147,6 +152,12 @@ std::string summary(const SimResult& r) {
   }
   if (!r.machine_error.empty()) {
     out += "machine: " + r.machine_error + "\n";
+  }
+  if (r.mill_spindle_on_after_stop || r.mill_drivers_on_after_stop) {
+    out += std::string("mill: WARNING after the stop the spindle was ") + (r.mill_spindle_on_after_stop ? "ON" : "off") +
+           " and the drivers " + (r.mill_drivers_on_after_stop ? "ON" : "off") +
+           (r.mill_on_after_relay ? "; still on after the watchdog relay's second\n"
+                                  : "; the watchdog relay dropped them a second later\n");
   }
   return out;
 }

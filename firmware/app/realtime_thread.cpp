@@ -8,6 +8,7 @@
 #include <unistd.h>
 #include <time.h>
 
+#include <cerrno>
 #include <cstring>
 #include <thread>
 
@@ -61,6 +62,40 @@ bool keep_off_cpu(int cpu) {
   }
   CPU_CLR(static_cast<std::size_t>(cpu), &cpus);
   return CPU_COUNT(&cpus) > 0 && sched_setaffinity(0, sizeof cpus, &cpus) == 0;
+}
+
+ThreadPriority run_this_thread_fifo(int priority, const std::string& who) {
+  const std::string asked = who + ": SCHED_FIFO at priority " + std::to_string(priority);
+  int error_number = EINVAL;
+  if (priority >= sched_get_priority_min(SCHED_FIFO) && priority <= sched_get_priority_max(SCHED_FIFO)) {
+    sched_param param{};
+    param.sched_priority = priority;
+    error_number = pthread_setschedparam(pthread_self(), SCHED_FIFO, &param);
+  }
+  ThreadPriority got;
+  if (error_number != 0) {
+    // Refused: explicitly back to (or left at) the normal policy, whatever the thread inherited.
+    sched_param normal{};
+    static_cast<void>(pthread_setschedparam(pthread_self(), SCHED_OTHER, &normal));
+    got.message = asked + " was refused (" +
+                  (error_number == EPERM ? std::string("not permitted: run as root or grant CAP_SYS_NICE, or raise RLIMIT_RTPRIO")
+                   : error_number == EINVAL ? "expected a priority from " + std::to_string(sched_get_priority_min(SCHED_FIFO)) +
+                                                  " to " + std::to_string(sched_get_priority_max(SCHED_FIFO))
+                                            : std::string(std::strerror(error_number))) +
+                  "): it runs at normal priority (SCHED_OTHER)";
+  }
+  // What the kernel says now, not what was asked.
+  int policy = SCHED_OTHER;
+  sched_param now{};
+  if (pthread_getschedparam(pthread_self(), &policy, &now) == 0 && policy == SCHED_FIFO) {
+    got.sched_fifo = true;
+    got.priority = now.sched_priority;
+  }
+  if (error_number == 0 && (!got.sched_fifo || got.priority != priority)) {
+    got.message = asked + " was taken but the thread runs " +
+                  (got.sched_fifo ? "SCHED_FIFO at priority " + std::to_string(got.priority) : std::string("another policy"));
+  }
+  return got;
 }
 
 RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs period_ns, const std::atomic<bool>& stop,

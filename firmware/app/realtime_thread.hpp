@@ -1,6 +1,7 @@
 // The cycle's thread: SCHED_FIFO at a priority, optionally pinned to a CPU, memory locked, its stack
 // prefaulted, woken by absolute clock_nanosleep on CLOCK_MONOTONIC once per period. Where the host
-// refuses real-time privileges it says so once and runs anyway, unless they are required.
+// refuses real-time privileges it says so once and runs anyway, unless they are required. And the
+// same priority for another thread of ours (the machine thread, below the cycle).
 #pragma once
 
 #include <atomic>
@@ -45,6 +46,21 @@ class CpuLatencyHold {
 // cycle's CPU runs the cycle and nothing of ours that sits in the kernel when the cycle should wake.
 // False (and nothing changed) when there is no other CPU or the host refuses.
 bool keep_off_cpu(int cpu);
+
+// What a thread asked for and what it got: it never claims a priority the kernel did not give it.
+struct ThreadPriority {
+  bool sched_fifo = false;  // the kernel says the thread runs SCHED_FIFO at `priority`
+  int priority = 0;         // its SCHED_FIFO priority; 0 when it runs SCHED_OTHER
+  std::string message;      // empty when it got what it asked; else one line: what was refused and why
+};
+
+// Init, on the thread itself: gives the calling thread SCHED_FIFO at `priority` (1 to 99), for a
+// thread that must keep its deadlines beside the cycle but yield to it (the machine thread: the
+// cycle's priority less a margin, above the records thread, which stays SCHED_OTHER). Where the
+// host does not permit it (no CAP_SYS_NICE and RLIMIT_RTPRIO below the priority) or the priority is
+// out of range, the thread runs SCHED_OTHER (put back there explicitly) and the message says so,
+// naming `who`, the priority and the reason. What it returns is what pthread_getschedparam then says.
+[[nodiscard]] ThreadPriority run_this_thread_fifo(int priority, const std::string& who);
 
 // Runs `cycle(now_ns, deadline_ns)` once per period on a new thread until it returns false or `stop`
 // is set; each call's deadline is the absolute start of its period. Blocks until the thread ends.

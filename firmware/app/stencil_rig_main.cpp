@@ -412,6 +412,17 @@ int main(int argc, char** argv) {
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
   TerminalCommands terminal;
   job.reset_requested = [&terminal] { return terminal.reset_typed(); };
+  // The machine thread runs SCHED_FIFO 10 below the cycle (which always preempts it) and above the
+  // records thread, which stays SCHED_OTHER with the journal's writes and fsyncs: the machine's
+  // updates keep their deadlines whatever the journal's disk does. Refused: it says so and runs on.
+  job.prepare_machine_thread = [priority] {
+    constexpr int kBelowTheCycle = 10;
+    const app::ThreadPriority got =
+        app::run_this_thread_fifo(priority > kBelowTheCycle ? priority - kBelowTheCycle : 1, "the machine thread");
+    if (!got.message.empty()) {
+      std::fprintf(stderr, "stencil-rig: %s\n", got.message.c_str());
+    }
+  };
   // Nothing turns the spindle on unattended: once homed, the operator types 'start' at the terminal.
   job.confirm_spindle = [&terminal] {
     std::printf("stencil-rig: homed. Hold the handle still near the tool, then type 'start' and Enter to turn the "

@@ -15,12 +15,19 @@ struct MachineCommandRecord {
   double target_tip_mm[3];         // where the tool's tip goes (world), the legs' common end
 };
 
-// The machine side's record (the journal): false when it could not be recorded, and the command is
-// then not sent.
+// The machine side's record (the journal). homed() is called by start(), before the machine thread
+// runs, and may block until the homing is in the record (false: not recorded, nothing moves).
+// command() and written() are called by the machine thread at its updates and never block on the
+// record's storage (real-time safe): command() queues a target (false: it cannot be recorded, and
+// it is not sent: a journal fault); written() says whether every target queued so far is in the
+// record. The machine side sends a target only once it is written, and holds the mill until then:
+// a target that was sent is always in the record, so a crash of the program cannot lose what was
+// machined (issue 18, item 10: the machine thread no longer waits on the journal's writes).
 class MachineRecorder {
  public:
   [[nodiscard]] virtual bool homed(std::int64_t time_ns) = 0;
   [[nodiscard]] virtual bool command(const MachineCommandRecord& record) = 0;
+  [[nodiscard]] virtual bool written() const = 0;
 
  protected:
   ~MachineRecorder() = default;

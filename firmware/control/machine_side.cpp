@@ -82,6 +82,22 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     stop(update_deadline_ns, true);
     return;
   }
+  // A target queued for the record at an earlier update goes out in this one once it is written;
+  // until then the mill holds (this update keeps its deadline: nothing here waits on the record's
+  // storage), and a journal fault only past the bound.
+  if (holding_unrecorded_ && !recorder_->written()) {
+    ++statistics_.held_for_record;
+    if (++unrecorded_updates_ > kMaxUnrecordedUpdates) {
+      record_failed_ = true;
+      stop(update_deadline_ns, true, MachineEventKind::JournalFailed);
+    }
+    return;
+  }
+  // Written: it goes below, after the next target is planned and queued, so that the records thread
+  // writes that one while the mill runs this one (the planner counts the held target as queued).
+  const bool send_held = holding_unrecorded_;
+  const motion::PlanResult held = unrecorded_;
+  holding_unrecorded_ = false;
   const std::uint64_t moves_done = link_.status().moves_done;
   const auto completed = static_cast<int>(std::min<std::uint64_t>(moves_done - moves_seen_, 8));
   moves_seen_ = moves_done;
@@ -96,7 +112,8 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     case motion::PlanStatus::Moved:
     case motion::PlanStatus::TakingUp: {
       if (recorder_ != nullptr) {
-        MachineCommandRecord record{statistics_.updates, update_deadline_ns, {}, {3, 3, 3}, {}};
+        // Its place among the targets sent: after the held one, when that goes in this update.
+        MachineCommandRecord record{statistics_.updates + (send_held ? 1U : 0U), update_deadline_ns, {}, {3, 3, 3}, {}};
         for (int i = 0; i < 3; ++i) {
           record.motor_target[i] = plan.motor_target.axis[static_cast<std::size_t>(i)];
           record.order[i] = plan.order[static_cast<std::size_t>(i)];
@@ -107,28 +124,16 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
           stop(update_deadline_ns, true, MachineEventKind::JournalFailed);
           return;
         }
-      }
-      const hal::MachineResult moved = link_.move({plan.motor_target.axis, plan.order, true}, update_deadline_ns);
-      if (!moved.done) {
-        stop(update_deadline_ns, true);
-        return;
-      }
-      ++statistics_.updates;
-      statistics_.take_ups += plan.status == motion::PlanStatus::TakingUp ? 1 : 0;
-      // The tool goes there one axis at a time, in the plan's order: each leg cuts the model.
-      for (const std::uint8_t axis : plan.order) {
-        if (axis > 2) {
-          continue;
+        // Not yet in the file (the records thread writes it within microseconds on a healthy disk),
+        // or the held target goes in this update (one target an update, as ever): it waits.
+        if (send_held || !recorder_->written()) {
+          unrecorded_ = plan;
+          holding_unrecorded_ = true;
+          unrecorded_updates_ = 0;
+          break;
         }
-        Eigen::Vector3d next = commanded_tip_mm_;
-        next[axis] = plan.target_mm[axis];
-        if (stock_ != nullptr && next != commanded_tip_mm_) {
-          stock_->cut(commanded_tip_mm_, next);
-        }
-        commanded_tip_mm_ = next;
       }
-      commanded_tip_mm_ = plan.target_mm;
-      statistics_.motor_steps += plan.motor_steps;
+      static_cast<void>(send(plan, update_deadline_ns));  // a link that fails stops the machine
       break;
     }
     case motion::PlanStatus::Blocked:
@@ -148,6 +153,34 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
     case motion::PlanStatus::Waiting:
       break;
   }
+  if (send_held && state_ == MachineSideState::Cutting) {
+    static_cast<void>(send(held, update_deadline_ns));  // a link that fails stops the machine
+  }
+}
+
+bool MachineSide::send(const motion::PlanResult& plan, hal::MonotonicNs deadline_ns) {
+  const hal::MachineResult moved = link_.move({plan.motor_target.axis, plan.order, true}, deadline_ns);
+  if (!moved.done) {
+    stop(deadline_ns, true);
+    return false;
+  }
+  ++statistics_.updates;
+  statistics_.take_ups += plan.status == motion::PlanStatus::TakingUp ? 1 : 0;
+  // The tool goes there one axis at a time, in the plan's order: each leg cuts the model.
+  for (const std::uint8_t axis : plan.order) {
+    if (axis > 2) {
+      continue;
+    }
+    Eigen::Vector3d next = commanded_tip_mm_;
+    next[axis] = plan.target_mm[axis];
+    if (stock_ != nullptr && next != commanded_tip_mm_) {
+      stock_->cut(commanded_tip_mm_, next);
+    }
+    commanded_tip_mm_ = next;
+  }
+  commanded_tip_mm_ = plan.target_mm;
+  statistics_.motor_steps += plan.motor_steps;
+  return true;
 }
 
 }  // namespace stencil::control

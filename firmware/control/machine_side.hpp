@@ -28,6 +28,7 @@ struct MachineSideStatistics {
   double max_lag_mm = 0.0;        // virtual tool to the mill's target, world
   double last_lag_mm = 0.0;       // the same at the newest update
   std::int64_t motor_steps = 0;   // all axes, take-up included
+  std::uint64_t held_for_record = 0;  // updates the mill held: the newest target not yet in the record
 };
 
 class MachineSide {
@@ -67,10 +68,16 @@ class MachineSide {
   // before start(); this side is its only writer, readers look once the machine thread is done or
   // between updates on the same thread.
   void keep_stock_model(CommandedStock* stock) { stock_ = stock; }
-  // Every homing and target goes to `recorder` before it is acted on (null: none). Set before start().
+  // Every homing and target goes to `recorder` before it is acted on (null: none): a target is sent
+  // once the recorder has it written, and until then the mill holds. Set before start().
   void record_to(MachineRecorder* recorder) { recorder_ = recorder; }
-  // The recorder refused a record: the machine did not start, or was stopped and the cycle told.
+  // The recorder refused a record, or kept a target unwritten past kMaxUnrecordedUpdates: the
+  // machine did not start, or was stopped and the cycle told (JournalFailed).
   [[nodiscard]] bool record_failed() const { return record_failed_; }
+  // More updates than this in a row holding a target the record has not written (4 s at 30 Hz, as
+  // long as the cycle's journal ring lasts on a stalled disk) is a journal fault; fewer only hold
+  // the mill (slow storage costs time, not the cut).
+  static constexpr int kMaxUnrecordedUpdates = 120;
   // More updates than this in a row with no legal staircase (3 s at 30 Hz) is a fault: stalled().
   static constexpr int kMaxBlockedUpdates = 90;
   [[nodiscard]] bool stalled() const { return stalled_; }
@@ -83,6 +90,8 @@ class MachineSide {
  private:
   // report: the event the cycle gets first (Fault, JournalFailed), or nothing when it stopped us.
   void stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineEventKind report = MachineEventKind::Fault);
+  // Sends a planned target and cuts the stock model along its legs; false when the link failed (stopped).
+  [[nodiscard]] bool send(const motion::PlanResult& plan, hal::MonotonicNs deadline_ns);
 
   hal::MachineLink& link_;
   MachineHandoffRing& from_cycle_;
@@ -95,6 +104,11 @@ class MachineSide {
   CommandedStock* stock_ = nullptr;
   MachineRecorder* recorder_ = nullptr;
   bool record_failed_ = false;
+  // A target queued for the record and not yet written: planned, not sent (the planner counts it
+  // queued, so nothing else is planned before it goes).
+  motion::PlanResult unrecorded_{};
+  bool holding_unrecorded_ = false;
+  int unrecorded_updates_ = 0;
   int blocked_in_a_row_ = 0;
   bool stalled_ = false;
   bool stop_confirmed_ = false;

@@ -1,10 +1,12 @@
-// JournalDrain: the journal thread's loop body. Every record the cycle left in its journal ring
-// goes to the journal file (when there is one); a record that cannot be written asks the cycle to
-// stop, once, on its command ring: the record must lose nothing. The thread that drains is the
-// command ring's one producer.
+// JournalDrain: the records thread's loop body. The machine thread's targets go to the journal file
+// first (the machine side holds the newest until it is there), then every record the cycle left in
+// its journal ring (when there is a file); a record that cannot be written asks the cycle to stop,
+// once, on its command ring: the record must lose nothing. The thread that drains is the command
+// ring's one producer. Between looks, wait() returns early when the machine thread queues a target.
 #pragma once
 
 #include <chrono>
+#include <thread>
 
 #include "firmware/control/cycle_messages.hpp"
 #include "firmware/control/display_feed.hpp"
@@ -17,6 +19,9 @@ class JournalDrain {
   JournalDrain(JournalWriter* writer, control::CommandRing& commands) : writer_(writer), commands_(commands) {}
 
   void drain(control::JournalRing& ring) {
+    if (writer_ != nullptr && !failed_ && !writer_->write_machine_commands()) {
+      failed_ = true;
+    }
     control::JournalRecord record{};
     while (ring.pop(record)) {
       if (display_ != nullptr) {
@@ -36,6 +41,16 @@ class JournalDrain {
       failed_ = true;
     }
     tell_the_cycle();
+  }
+
+  // Between looks (instead of sleeping `most`): back as soon as the machine thread has queued a
+  // target, so that it is written before the machine side's next update, which sends it.
+  void wait(std::chrono::nanoseconds most) {
+    if (writer_ != nullptr) {
+      writer_->wait_for_machine_commands(most);
+    } else {
+      std::this_thread::sleep_for(most);
+    }
   }
 
   [[nodiscard]] bool failed() const { return failed_; }

@@ -24,7 +24,8 @@ enum class RecordType : std::uint8_t {
   Cycle = 2,      // one cycle: the device sample it read and the virtual tool it left
   SafeState = 3,  // the cycle entered its safe state (synced at once)
   Homed = 4,      // the machine homed: its tool is at home from here (written through at once)
-  MachineCommand = 5,  // a target, recorded by the machine thread before it is sent (written through)
+  MachineCommand = 5,  // a target: queued by the machine thread, written through by the records
+                       // thread, and sent only once written (a crash cannot lose one that was sent)
   Resume = 6,     // a resumed job's next segment starts here (its cycles count from 0 again)
   End = 7,        // the run ended in order (a run without one was killed or crashed)
 };

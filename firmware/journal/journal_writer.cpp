@@ -3,6 +3,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <ctime>
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -16,12 +17,33 @@ namespace {
 constexpr std::int64_t kSyncEveryNs = 1'000'000'000;
 constexpr std::size_t kWriteOutBytes = 64 * 1024;  // a buffer this full is written out at once
 
+class PosixJournalStorage final : public JournalStorage {
+ public:
+  ssize_t write(int fd, const std::uint8_t* data, std::size_t size) override { return ::write(fd, data, size); }
+  int fsync(int fd) override { return ::fsync(fd); }
+};
+
 }  // namespace
 
-JournalWriter::~JournalWriter() { static_cast<void>(close()); }
+JournalStorage& posix_journal_storage() {
+  static PosixJournalStorage storage;
+  return storage;
+}
+
+JournalWriter::JournalWriter(JournalStorage& storage) : storage_(storage) {
+  // A process-private semaphore: sem_post is a futex wake (no lock, no allocation), safe from the
+  // machine thread; the records thread waits on it with a timeout.
+  static_cast<void>(sem_init(&machine_queued_signal_, 0, 0));
+}
+
+JournalWriter::~JournalWriter() {
+  static_cast<void>(close());
+  sem_destroy(&machine_queued_signal_);
+}
 
 bool JournalWriter::fail(const std::string& what, int error_number) {
   failed_ = true;
+  accepting_.store(false);
   error_ = path_ + ": " + what + (error_number != 0 ? std::string(": ") + std::strerror(error_number) : std::string());
   return false;
 }
@@ -48,7 +70,9 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
   payload.u16(static_cast<std::uint16_t>(job_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(start.job.data()), job_length);
   add_record(RecordType::Start, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync_locked(lock);
+  const bool synced = sync_locked(lock);
+  accepting_.store(synced);
+  return synced;
 }
 
 bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_bytes, const JournalResume& resume) {
@@ -73,12 +97,14 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
   add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  return sync_locked(lock);
+  const bool synced = sync_locked(lock);
+  accepting_.store(synced);
+  return synced;
 }
 
 bool JournalWriter::append_homed(std::int64_t time_ns) {
   const std::lock_guard<std::mutex> lock(mutex_);
-  if (fd_ < 0 || failed_) {
+  if (fd_ < 0 || failed_ || !write_machine_commands_locked()) {
     return false;
   }
   ByteWriter payload;
@@ -87,19 +113,66 @@ bool JournalWriter::append_homed(std::int64_t time_ns) {
   return write_out();
 }
 
+// The machine thread: never the lock (the records thread may be inside a long write() with it).
 bool JournalWriter::append_machine_command(const control::MachineCommandRecord& record) {
+  if (!accepting_.load(std::memory_order_acquire)) {
+    return false;
+  }
+  if (!machine_ring_.push(record)) {
+    machine_refused_.fetch_add(1);  // not queued, so not sent: the machine side stops on a journal fault
+    return false;
+  }
+  ++machine_queued_;
+  static_cast<void>(sem_post(&machine_queued_signal_));
+  return true;
+}
+
+bool JournalWriter::machine_commands_written() const {
+  return machine_written_.load(std::memory_order_acquire) >= machine_queued_;
+}
+
+bool JournalWriter::write_machine_commands() {
   const std::lock_guard<std::mutex> lock(mutex_);
   if (fd_ < 0 || failed_) {
     return false;
   }
-  ByteWriter payload;
-  encode_machine_command(record, payload);
-  add_record(RecordType::MachineCommand, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  if (!write_out()) {  // in the file before the mill is sent it: a crash of this program cannot lose it
-    return false;
+  return write_machine_commands_locked();
+}
+
+// Under mutex_: every queued target into the buffer, the buffer to the file, then the targets are
+// published as written (a crash of the program from here on cannot lose them: the kernel has them).
+bool JournalWriter::write_machine_commands_locked() {
+  control::MachineCommandRecord record{};
+  std::uint64_t taken = 0;
+  while (machine_ring_.pop(record)) {
+    ByteWriter payload;
+    encode_machine_command(record, payload);
+    add_record(RecordType::MachineCommand, payload.data(), static_cast<std::uint32_t>(payload.size()));
+    ++taken;
   }
-  ++machine_records_;
+  if (taken == 0) {
+    return true;
+  }
+  if (!write_out()) {
+    return false;  // not published: the machine side holds the target, and the cycle is told
+  }
+  machine_taken_ += taken;
+  machine_records_ += taken;
+  machine_written_.store(machine_taken_, std::memory_order_release);
   return true;
+}
+
+void JournalWriter::wait_for_machine_commands(std::chrono::nanoseconds most) {
+  timespec until{};
+  clock_gettime(CLOCK_MONOTONIC, &until);
+  const std::int64_t ns = static_cast<std::int64_t>(until.tv_nsec) + most.count();
+  until.tv_sec += static_cast<time_t>(ns / 1'000'000'000);
+  until.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  while (sem_clockwait(&machine_queued_signal_, CLOCK_MONOTONIC, &until) != 0 && errno == EINTR) {
+  }
+  while (sem_trywait(&machine_queued_signal_) == 0) {
+    // the posts of targets this look takes together: one look for all of them
+  }
 }
 
 void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length) {
@@ -118,7 +191,7 @@ void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std
 
 bool JournalWriter::append(const control::JournalRecord& r) {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (fd_ < 0 || failed_) {
+  if (fd_ < 0 || failed_ || !write_machine_commands_locked()) {
     return false;
   }
   ByteWriter payload;
@@ -141,7 +214,7 @@ bool JournalWriter::append(const control::JournalRecord& r) {
 
 bool JournalWriter::append_end(std::uint64_t cycles, control::SafeReason reason) {
   std::unique_lock<std::mutex> lock(mutex_);
-  if (fd_ < 0 || failed_) {
+  if (fd_ < 0 || failed_ || !write_machine_commands_locked()) {
     return false;
   }
   ByteWriter payload;
@@ -154,7 +227,7 @@ bool JournalWriter::append_end(std::uint64_t cycles, control::SafeReason reason)
 bool JournalWriter::write_out() {
   std::size_t done = 0;
   while (done < buffer_.size()) {
-    const ssize_t n = ::write(fd_, buffer_.data() + done, buffer_.size() - done);
+    const ssize_t n = storage_.write(fd_, buffer_.data() + done, buffer_.size() - done);
     if (n < 0) {
       if (errno == EINTR) {
         continue;
@@ -173,18 +246,19 @@ bool JournalWriter::sync() {
   return sync_locked(lock);
 }
 
-// Writes out under the lock, then fsyncs without it: the machine thread must not wait on the disk
-// to record its next command (fd_ stays open until close(), after both threads are done).
+// Writes out under the lock (the machine's targets first), then fsyncs without it, so that a
+// fsync's seconds on slow storage never hold up whoever locks next (fd_ stays open until close(),
+// after the threads that feed the writer are done).
 bool JournalWriter::sync_locked(std::unique_lock<std::mutex>& lock) {
   if (fd_ < 0 || failed_) {
     return false;
   }
-  if (!write_out()) {
+  if (!write_machine_commands_locked() || !write_out()) {
     return false;
   }
   const int fd = fd_;
   lock.unlock();
-  const int synced = ::fsync(fd);
+  const int synced = storage_.fsync(fd);
   const int error_number = errno;
   lock.lock();
   if (synced != 0) {
@@ -209,6 +283,7 @@ bool JournalWriter::sync_if_due(std::int64_t now_ns) {
 
 bool JournalWriter::close() {
   std::unique_lock<std::mutex> lock(mutex_);
+  accepting_.store(false);  // the machine thread is done by now; a target queued after this is refused
   if (fd_ < 0) {
     return !failed_;
   }

@@ -285,10 +285,34 @@ case_journal_holds_every_cycle() {
   grep -q '"journal": null' report4.json || fail "--no-journal still wrote a journal"
 }
 
-# SIGTERM mid-cut: the run ends in the safe state "stopped" (exit 3) with its report and journal
-# written, the safe-state event in the journal.
-case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
-  echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIGTERM once cutting)"
+# mill_off_at_end REPORT WHAT [relay]: the simulated mill's spindle and drivers (its power as the
+# board's latches leave it, not what the driver believes) are off once the machine side stopped it.
+# With "relay" (a link fault: the driver may not reach the controller to turn them off) they may stay
+# on until the rig's watchdog relay drops them a second later, and must be off then.
+mill_off_at_end() {
+  local report=$1 what=$2 mode=${3:-}
+  grep -q '"on_after_watchdog_relay": false' "$report" ||
+    fail "$what: the spindle or the drivers are on even after the watchdog relay's second"
+  if [ "$mode" = relay ]; then
+    if ! grep -q '"stop_confirmed": true' "$report"; then
+      grep -q '"spindle_on_after_stop": false' "$report" && grep -q '"drivers_on_after_stop": false' "$report" ||
+        grep -q '"watchdog_relay_dropped_power": true' "$report" ||
+        fail "$what: the stop was not confirmed and the watchdog relay did not drop the power"
+    fi
+    return
+  fi
+  grep -q '"spindle_on_after_stop": false' "$report" || fail "$what: the spindle is on after the stop"
+  grep -q '"drivers_on_after_stop": false' "$report" || fail "$what: the drivers are on after the stop"
+  grep -q '"stop_confirmed": true' "$report" || fail "$what: the link did not confirm the stop"
+}
+
+# SIGNAL mid-cut (SIGTERM; SIGHUP, a closed terminal; SIGQUIT, Ctrl-\): the run ends in the safe state
+# "stopped" (exit 3) with its report and journal written, the safe-state event in the journal, and
+# the mill's spindle and drivers off, the link having confirmed it (issue 18, item 1: before, a
+# SIGHUP killed the run with the spindle latched on).
+signal_mid_cut() {
+  local signal=$1
+  echo "\$ stencil-sim --speed 10 --pattern raster --journal job.journal --report report.json  (SIG$signal once cutting)"
   "$sim" --speed 10 --pattern raster --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
   local pid=$! waited=0
   # Mid-cut: once the journal holds about a simulated second of cycles (slow builds take a while).
@@ -296,7 +320,7 @@ case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
     sleep 0.1
     waited=$((waited + 1))
   done
-  kill -TERM "$pid"
+  kill -"$signal" "$pid"
   wait "$pid"
   status=$?
   sed 's/^/  stdout: /' stdout.txt
@@ -304,8 +328,12 @@ case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() {
   expect_status 3
   grep -q '"safe_state": "stopped"' report.json || fail "the report does not give the safe state stopped: $(grep safe_state report.json)"
   grep -q "safe state: stopped" stdout.txt || fail "the summary does not say the run was stopped"
-  journal_size_ok job.journal report.json 1 "SIGTERM"
+  mill_off_at_end report.json "SIG$signal"
+  journal_size_ok job.journal report.json 1 "SIG$signal"
 }
+case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() { signal_mid_cut TERM; }
+case_sighup_mid_cut_leaves_the_mill_off() { signal_mid_cut HUP; }
+case_sigquit_mid_cut_leaves_the_mill_off() { signal_mid_cut QUIT; }
 
 # The fault suite's job, shared by every case: a raster over a tall block beside home, so that the
 # cut is under way 25 s in; 60 simulated seconds. The uninterrupted run is the reference_job case,
@@ -371,6 +399,7 @@ expect_fault() {
   awk -v s="$safe" -v m="$stopped" 'BEGIN { exit !(m >= 0 && m - s <= 0.067) }' ||
     fail "$kind: the mill stopped at $stopped s, the safe state at $safe s; expected by the next machine update"
   journal_size_ok job.journal report.json 1 "$kind"
+  mill_off_at_end report.json "$kind" "$([ "$reason" = machine_fault ] && echo relay)"
   resume_matches_reference "$reason" "$kind"
 }
 
