@@ -230,3 +230,24 @@ TEST(SerialPort, HangUpOnCloseIsClearSoTheModemLinesStayUp) {
   CHECK_EQUAL(static_cast<tcflag_t>(CS8), settings.c_cflag & CSIZE);
   CHECK_EQUAL(static_cast<speed_t>(B57600), cfgetospeed(&settings));
 }
+
+// Issue 18, item 7: the CY545 drives CTS only once a Mode command enables it (manual, chapter 16),
+// which the driver does not send; with CRTSCTS on a port with modem lines the kernel would hold
+// every byte or none on a level that means nothing. The port comes out with it off, whatever the
+// last program left (here set beforehand, as a UART's earlier user might have).
+TEST(SerialPort, HardwareFlowControlIsOffWhateverTheLastProgramLeft) {
+  Pty pty;
+  termios settings{};
+  CHECK(tcgetattr(pty.master_fd, &settings) == 0);
+  settings.c_cflag |= CRTSCTS;
+  CHECK(tcsetattr(pty.master_fd, TCSANOW, &settings) == 0);
+  CHECK(tcgetattr(pty.master_fd, &settings) == 0);
+  CHECK_TEXT((settings.c_cflag & CRTSCTS) != 0, "the pseudo-terminal did not keep CRTSCTS: the test proves nothing");
+
+  SerialPort port;
+  char error[256] = {};
+  CHECK_TEXT(port.open(pty.path(), error), error);
+
+  CHECK(tcgetattr(pty.master_fd, &settings) == 0);
+  CHECK_EQUAL(0u, settings.c_cflag & CRTSCTS);
+}
