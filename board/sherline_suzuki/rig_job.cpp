@@ -50,7 +50,7 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
   return config;
 }
 
-RigResult run_rig(const RigJob& job, const PeriodicRunner& runner) {
+RigResult run_rig(const RigJob& job, const runtime::PeriodicRunner& runner) {
   RigResult result;
   const tables::PartTables& part = *job.part;
   const motion::MachineFrames frames = rig_frames(job.offset);

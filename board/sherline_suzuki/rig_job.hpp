@@ -18,6 +18,7 @@
 #include "firmware/journal/job_history.hpp"
 #include "firmware/journal/journal_writer.hpp"
 #include "firmware/motion/machine_frames.hpp"
+#include "firmware/runtime/periodic_runner.hpp"
 #include "firmware/tables/part_tables.hpp"
 #include "hal/clock.hpp"
 #include "hal/haptic_device.hpp"
@@ -36,11 +37,6 @@ struct WorkOffset {
 // The rig's frames: world = device / 10, every axis counting into the workspace from its switch;
 // a tool that sticks out further puts the tip lower at home.
 [[nodiscard]] motion::MachineFrames rig_frames(const WorkOffset& offset);
-
-// As stencil-sim's: cycle(now_ns, deadline_ns) once per period until it returns false or stop.
-using PeriodicRunner = std::function<bool(hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
-                                          const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
-                                          std::string& error)>;
 
 struct RigJob {
   const tables::PartTables* part = nullptr;
@@ -109,6 +105,6 @@ struct RigResult {
 // The cycle's configuration for this job (frames, reach, speed limit, watchdogs), as run_rig uses it.
 [[nodiscard]] control::ControllerConfig rig_controller_config(const RigJob& job);
 
-[[nodiscard]] RigResult run_rig(const RigJob& job, const PeriodicRunner& runner);
+[[nodiscard]] RigResult run_rig(const RigJob& job, const runtime::PeriodicRunner& runner);
 
 }  // namespace stencil::board::sherline_suzuki

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <cerrno>
 #include <csignal>
-#include <ctime>
 #include <new>
 
 #include <sched.h>
@@ -13,22 +12,16 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "hal/posix_clock/monotonic_clock.hpp"
+
 namespace stencil::board::sim {
 namespace {
 
 constexpr std::int64_t kPeriodNs = 1'000'000;
 
-std::int64_t wall_ns() {
-  timespec t{};
-  clock_gettime(CLOCK_MONOTONIC, &t);
-  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
-}
-
-void sleep_until(std::int64_t at_ns) {
-  const timespec wake{static_cast<time_t>(at_ns / 1'000'000'000), static_cast<long>(at_ns % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &wake, nullptr) == EINTR) {
-  }
-}
+// The wall clock the device keeps once on its own: CLOCK_MONOTONIC, as the cycle's.
+using hal::posix_clock::monotonic_now_ns;
+using hal::posix_clock::sleep_until_monotonic_ns;
 
 struct Child {
   stencil::sim::SimulatedHapticDevice& device;
@@ -58,22 +51,22 @@ struct Child {
 
   // The controller is gone: on the wall clock, as the device would carry on, until the force is zero.
   [[noreturn]] void orphaned(double script_s, std::int64_t device_ns) {
-    const std::int64_t gone = wall_ns();
+    const std::int64_t gone = monotonic_now_ns();
     std::fprintf(log, "device: the controller's process is gone %.3f s into the job; force %s\n", script_s,
                  device.output().force_applied ? "still applied" : "already zero");
     std::fflush(log);
     for (std::int64_t next = gone;; next += kPeriodNs) {
-      sleep_until(next);
+      sleep_until_monotonic_ns(next);
       device_ns += kPeriodNs;
       millisecond(script_s, device_ns);
       const stencil::sim::DeviceOutput out = device.output();
       if (!out.force_applied) {
         std::fprintf(log, "device: force zero %.1f ms after the controller was gone (host watchdog trips: %llu)\n",
-                     static_cast<double>(wall_ns() - gone) / 1e6, static_cast<unsigned long long>(out.watchdog_trips));
+                     static_cast<double>(monotonic_now_ns() - gone) / 1e6, static_cast<unsigned long long>(out.watchdog_trips));
         std::fflush(log);
         _exit(0);
       }
-      if (wall_ns() - gone > 1'000'000'000) {
+      if (monotonic_now_ns() - gone > 1'000'000'000) {
         std::fprintf(log, "device: force still applied a second after the controller was gone\n");
         std::fflush(log);
         _exit(1);
@@ -83,9 +76,9 @@ struct Child {
 
   [[noreturn]] void free_running() {
     std::int64_t first_command_ns = -1;
-    for (std::int64_t next = wall_ns();; next += kPeriodNs) {
-      sleep_until(next);
-      const std::int64_t now = wall_ns();
+    for (std::int64_t next = monotonic_now_ns();; next += kPeriodNs) {
+      sleep_until_monotonic_ns(next);
+      const std::int64_t now = monotonic_now_ns();
       if (first_command_ns < 0 && device.output().commands_accepted > 0) {
         first_command_ns = now;
       }
@@ -160,9 +153,9 @@ bool DeviceProcess::step(std::int64_t now_ns, double script_s) {
   shared_->script_s.store(script_s);
   const std::uint64_t go = shared_->go.load() + 1;
   shared_->go.store(go);
-  const std::int64_t give_up = wall_ns() + 1'000'000'000;
+  const std::int64_t give_up = monotonic_now_ns() + 1'000'000'000;
   for (std::uint64_t spins = 0; shared_->done.load() != go; ++spins) {
-    if (spins % 64 == 0 && wall_ns() > give_up) {
+    if (spins % 64 == 0 && monotonic_now_ns() > give_up) {
       return false;
     }
     sched_yield();

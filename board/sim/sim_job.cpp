@@ -363,7 +363,7 @@ SimResult finish_result(SimResult& result, const tables::PartTables& part, const
   return result;
 }
 
-SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
+SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   const bool realtime = runner != nullptr;
   SimResult result;
   const tables::PartTables& part = *job.part;
@@ -372,7 +372,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
 
   // The far side of the serial cable: the mill, its fake CY545 on a pty, the clock they follow.
   stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
-  const hal::MonotonicNs epoch_ns = realtime ? stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() : 0;
+  const hal::MonotonicNs epoch_ns = realtime ? hal::posix_clock::monotonic_now_ns() : 0;
   stencil::sim::cy545::FakeCy545 fake{mill, epoch_ns};
   // Virtual time only: it gives the fake's bytes their wire time and its commands the chip's time,
   // which in real time the fake cannot know (a pty merges the driver's writes).
@@ -583,7 +583,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
             device.device_cycle(hand, job.script.angles_at(script_s), now_ns);
           }
           const control::CycleStatus status = controller->step(now_ns, deadline_ns);
-          controller->finish(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns(), deadline_ns + kPeriodNs);
+          controller->finish(hal::posix_clock::monotonic_now_ns(), deadline_ns + kPeriodNs);
           if (status == control::CycleStatus::SafeState) {
             return false;
           }
@@ -610,7 +610,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     records.drain(rings->journal);  // the last records, left after the records thread's last look
     machine->shut_down(machine_clock.now_ns() + kUpdateBoundNs);  // while the fake still answers
     fake_runner.reset();
-    leave_the_mill(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns());
+    leave_the_mill(hal::posix_clock::monotonic_now_ns());
     if (!ran) {
       result.started = false;
       result.error = runner_error;
@@ -618,7 +618,7 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
     }
     machined.flush();
     return finish_result(result, part, *controller, *machine, model, machined, link, controller->statistics().compute,
-                         static_cast<double>(stencil::sim::cy545::FakeCy545Runner::monotonic_now_ns() - start_ns) / 1e9,
+                         static_cast<double>(hal::posix_clock::monotonic_now_ns() - start_ns) / 1e9,
                          wall_start, mill, true);
   }
   const hal::MonotonicNs start_ns = (machine_clock.now_ns() / kPeriodNs + 1) * kPeriodNs;
@@ -765,37 +765,6 @@ SimResult run_job(const SimJob& job, const PeriodicRunner* runner) {
 
 SimResult run_fast(const SimJob& job) { return run_job(job, nullptr); }
 
-namespace {
-constexpr std::pair<FaultKind, const char*> kFaultNames[] = {
-    {FaultKind::DeviceFrozen, "device-frozen"},   {FaultKind::PoseNan, "pose-nan"},
-    {FaultKind::PoseJump, "pose-jump"},           {FaultKind::DeviceFault, "device-fault"},
-    {FaultKind::Cy545Silent, "cy545-silent"},     {FaultKind::Cy545Garbled, "cy545-garbled"},
-    {FaultKind::SerialGarbage, "serial-garbage"}, {FaultKind::SerialClosed, "serial-closed"},
-    {FaultKind::PositionMismatch, "position-mismatch"}, {FaultKind::CanBadFrames, "can-bad-frames"},
-    {FaultKind::OverrunStorm, "overrun-storm"},
-};
-}  // namespace
-
-const char* fault_kind_name(FaultKind kind) {
-  for (const auto& [k, name] : kFaultNames) {
-    if (k == kind) {
-      return name;
-    }
-  }
-  return "none";
-}
-
-bool parse_fault_kind(const std::string& name, FaultKind& kind) {
-  for (const auto& [k, n] : kFaultNames) {
-    if (name == n) {
-      kind = k;
-      return true;
-    }
-  }
-  return false;
-}
-
-SimResult run_realtime(const SimJob& job, const PeriodicRunner& runner) { return run_job(job, &runner); }
-
+SimResult run_realtime(const SimJob& job, const runtime::PeriodicRunner& runner) { return run_job(job, &runner); }
 
 }  // namespace stencil::board::sim

@@ -13,6 +13,7 @@
 
 #include <Eigen/Core>
 
+#include "board/sim/fault_injection.hpp"
 #include "firmware/control/controller.hpp"
 #include "firmware/control/cycle_messages.hpp"
 #include "firmware/control/display_feed.hpp"
@@ -20,6 +21,7 @@
 #include "firmware/journal/job_history.hpp"
 #include "firmware/motion/machine_frames.hpp"
 #include "firmware/journal/journal_writer.hpp"
+#include "firmware/runtime/periodic_runner.hpp"
 #include "firmware/tables/part_tables.hpp"
 #include "hal/clock.hpp"
 #include "sim/mill/stock_zmap.hpp"
@@ -41,30 +43,6 @@ inline constexpr double kOperatorSpeedMmPerS = 0.8;
 // How the cycle reaches the simulated device: in process, or through the real backends' code over a
 // memfd window (the PIO card's layout) or a socketpair carrying CAN frames.
 enum class HapticTransport : std::uint8_t { Direct, Pio, Can };
-
-// One fault injected mid-job (fast and paced runs): on the device's side, on the serial line, or in
-// the CY545's answers.
-enum class FaultKind : std::uint8_t {
-  None,
-  DeviceFrozen,      // the device stops: no sample, no heartbeat
-  PoseNan,           // its samples carry NaN positions from then on
-  PoseJump,          // one sample 100 mm off
-  DeviceFault,       // it reports its own fault (amplifier, encoder)
-  Cy545Silent,       // the CY545 stops answering (commands still run)
-  Cy545Garbled,      // its answers arrive with every byte's top bit flipped
-  SerialGarbage,     // bytes nobody asked for on the line
-  SerialClosed,      // the cable is pulled: the pty's master closes
-  PositionMismatch,  // the CY545 reports a position 100 steps off the one commanded
-  CanBadFrames,      // over CAN, 20 ms of bad frames instead of the device's: a wrong DLC, halves whose counters disagree
-  OverrunStorm,      // the cycle starts 1.5 periods late, every period from then on (a stalled host)
-};
-struct FaultInjection {
-  FaultKind kind = FaultKind::None;
-  double at_s = 0.0;  // simulated seconds from the start of the job
-};
-// "device-frozen", ... (the --inject names); parse_fault_kind gives false for an unknown name.
-[[nodiscard]] const char* fault_kind_name(FaultKind kind);
-[[nodiscard]] bool parse_fault_kind(const std::string& name, FaultKind& kind);
 
 struct SimJob {
   HapticTransport transport = HapticTransport::Direct;
@@ -97,12 +75,6 @@ struct SimJob {
   // its requests go into the command ring.
   control::DisplayFeed* display = nullptr;
 };
-
-// Runs cycle(now_ns, deadline_ns) once per period (on a real-time thread, where the host allows)
-// until it returns false or `stop` is set. False with `error` when it refused to run.
-using PeriodicRunner = std::function<bool(hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
-                                          const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
-                                          std::string& error)>;
 
 struct Quantiles {
   double p50, p99, p999, max;
@@ -182,7 +154,7 @@ struct SimResult {
 // Runs the job in real time: the cycle on `runner`'s thread each millisecond, the machine side on a
 // thread of its own at the update rate, the fake CY545 serviced on the pty in real time, the journal
 // and telemetry drained at 20 Hz; overruns count.
-[[nodiscard]] SimResult run_realtime(const SimJob& job, const PeriodicRunner& runner);
+[[nodiscard]] SimResult run_realtime(const SimJob& job, const runtime::PeriodicRunner& runner);
 
 // The lowest the part's tool can have its tip over (x, y) without entering the part, from the
 // part's top over a 0.05 mm grid of the stock (the scripted operator's idea of the part).

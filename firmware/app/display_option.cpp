@@ -6,9 +6,16 @@
 
 #ifdef STENCIL_HAVE_HMI
 #include "firmware/hmi/hmi_server.hpp"
+#else
+namespace stencil::hmi {
+// Built without civetweb (a cross build without the target's libcivetweb-dev, say): there is no
+// server and Display's server_ stays null; this empty class only completes its type for ~Display.
+class HmiServer {};
+}  // namespace stencil::hmi
 #endif
 
 namespace stencil::app {
+#ifdef STENCIL_HAVE_HMI
 namespace {
 
 double now_s() {
@@ -16,6 +23,7 @@ double now_s() {
 }
 
 }  // namespace
+#endif
 
 void add_display_options(CLI::App& app, DisplayOptions& options) {
   options.flag = app.add_option("--hmi", options.endpoint,

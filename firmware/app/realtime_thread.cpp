@@ -6,26 +6,18 @@
 #include <fcntl.h>
 #include <sys/mman.h>
 #include <unistd.h>
-#include <time.h>
 
 #include <cerrno>
 #include <cstring>
 #include <thread>
 
+#include "hal/posix_clock/monotonic_clock.hpp"
+
 namespace stencil::app {
 namespace {
 
-hal::MonotonicNs monotonic_now() {
-  timespec now{};
-  clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<hal::MonotonicNs>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
-}
-
-void sleep_until(hal::MonotonicNs deadline) {
-  const timespec at{static_cast<time_t>(deadline / 1'000'000'000), static_cast<long>(deadline % 1'000'000'000)};
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &at, nullptr) == EINTR) {
-  }
-}
+using hal::posix_clock::monotonic_now_ns;
+using hal::posix_clock::sleep_until_monotonic_ns;
 
 // Touches the pages the cycle's stack will use, so the first deep call does not fault them in.
 __attribute__((noinline)) void prefault_stack() {
@@ -135,17 +127,17 @@ RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs peri
     if (!setup.dma_latency_held) {
       announce("/dev/cpu_dma_latency could not be held at 0: the CPUs may sleep deeply between cycles");
     }
-    hal::MonotonicNs deadline = (monotonic_now() / period_ns + 1) * period_ns;
+    hal::MonotonicNs deadline = (monotonic_now_ns() / period_ns + 1) * period_ns;
     while (!stop.load(std::memory_order_relaxed)) {
-      sleep_until(deadline);
-      if (!cycle(monotonic_now(), deadline)) {
+      sleep_until_monotonic_ns(deadline);
+      if (!cycle(monotonic_now_ns(), deadline)) {
         break;
       }
       deadline += period_ns;
       // Periods that went by whole while the cycle was late (a stall of the host) are skipped
       // rather than run back to back, each of which would overrun in turn; the period now under
       // way runs at once, late. The controller counts the periods skipped.
-      const hal::MonotonicNs now = monotonic_now();
+      const hal::MonotonicNs now = monotonic_now_ns();
       if (now >= deadline + period_ns) {
         deadline += ((now - deadline) / period_ns) * period_ns;
       }

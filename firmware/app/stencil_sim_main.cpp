@@ -19,6 +19,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "board/sim/fault_injection.hpp"
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
 #include "firmware/app/display_option.hpp"
@@ -214,10 +215,9 @@ int main(int argc, char** argv) {
   std::string inject_text;
   board::sim::FaultInjection job_fault;
   app.add_option("--inject", inject_text,
-                 "KIND@S: inject one fault S simulated seconds into the job (--fast or --speed N other than 1); KIND is "
-                 "device-frozen, pose-nan, pose-jump, device-fault, cy545-silent, cy545-garbled, serial-garbage, "
-                 "serial-closed, position-mismatch, can-bad-frames (needs --haptic-transport can) or overrun-storm; the report's fault section says when the safe state, zero force "
-                 "and the stopped mill followed");
+                 "KIND@S: inject one fault S simulated seconds into the job (--fast or --speed N other than 1); KIND is " +
+                     board::sim::fault_kind_names(board::sim::FaultKindList::Sentence) +
+                     "; the report's fault section says when the safe state, zero force and the stopped mill followed");
   std::string journal_path;
   bool no_journal = false;
   std::string resume_path;
@@ -278,9 +278,8 @@ int main(int argc, char** argv) {
     double at_s = 0.0;
     if (at == std::string::npos || !board::sim::parse_fault_kind(inject_text.substr(0, at), job_fault.kind) ||
         !sim::parse_finite_field(inject_text.substr(at + 1), at_s) || at_s < 0.0) {
-      return bad_input("--inject " + inject_text + ": expected KIND@SECONDS, KIND one of device-frozen, pose-nan, pose-jump, "
-                       "device-fault, cy545-silent, cy545-garbled, serial-garbage, serial-closed, position-mismatch, "
-                       "can-bad-frames, overrun-storm");
+      return bad_input("--inject " + inject_text + ": expected KIND@SECONDS, KIND one of " +
+                       board::sim::fault_kind_names(board::sim::FaultKindList::Plain));
     }
     job_fault.at_s = at_s;
     if (job_fault.kind == board::sim::FaultKind::CanBadFrames && transport != "can") {

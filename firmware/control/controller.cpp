@@ -1,4 +1,4 @@
-// The cycle: read -> check -> engine -> write -> hand off, and the latched safe state.
+// The cycle: commands -> read -> engine -> write -> publish, and the latched safe state.
 #include "firmware/control/controller.hpp"
 
 #include <algorithm>
@@ -148,7 +148,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
     } else if (event.kind == MachineEventKind::JournalFailed) {
       enter_safe_state(SafeReason::JournalFailed);
     } else if (event.kind == MachineEventKind::Backlog) {
-      backlog_percent_ = event.fault;
+      backlog_percent_ = event.backlog_percent;
     }
   }
 }
@@ -233,6 +233,20 @@ bool Controller::read_device(hal::MonotonicNs now_ns) {
 }
 
 CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+  begin_cycle(now_ns, deadline_ns);
+  if (!ready_) {
+    enter_safe_state(SafeReason::EngineFault);  // no contact tool (bad tables): never any force
+  }
+  handle_commands(now_ns);
+  const bool usable = read_device(now_ns);
+  release_held_start(now_ns, usable);
+  const EngineOutcome outcome = run_engine(usable);
+  write_force(now_ns, usable, outcome.output);
+  publish(now_ns, deadline_ns, outcome);
+  return safe_reason_ == SafeReason::None ? CycleStatus::Running : CycleStatus::SafeState;
+}
+
+void Controller::begin_cycle(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
   ++cycle_;
   step_start_ns_ = now_ns;
   statistics_.wakeup_latency.add(now_ns - deadline_ns);
@@ -245,19 +259,9 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     ramp_start_ns_ = now_ns;
     still_since_ns_ = now_ns;
   }
-  if (!ready_) {
-    enter_safe_state(SafeReason::EngineFault);
-  }
-  handle_commands(now_ns);
-  const bool usable = read_device(now_ns);
+}
 
-  // The engine: the device's tip in the world, the contact there, the virtual tool towards it.
-  Telemetry telemetry{};
-  telemetry.remediation = engine::RemediationStatus::Stuck;
-  const Eigen::Vector3d device = position_of(sample_);
-  const Eigen::Vector3d desired = motion::device_to_world(config_.frames, device);
-  engine::ContactResult contact{engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  engine::HapticOutput output{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false};
+void Controller::release_held_start(hal::MonotonicNs now_ns, bool usable) {
   // A held start: nothing follows the hand until it is held still near the tool, as for a reset, so
   // a handle left resting away from the tool cannot pull the tool (and the mill) the moment it starts.
   if (waiting_for_hand_ && safe_reason_ == SafeReason::None && usable &&
@@ -266,52 +270,83 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
     ramp_start_ns_ = now_ns;
     ramping_ = true;
   }
-  if (safe_reason_ == SafeReason::None && usable && !waiting_for_hand_) {
-    // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
-    // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
-    const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
-    if (std::isfinite(config_.max_axis_move_mm) && std::isfinite(config_.max_total_move_mm)) {
-      tool_.limit_speed(backlog_scale * config_.max_axis_move_mm, backlog_scale * config_.max_total_move_mm);
-    }
-    contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
-    const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
-    telemetry.remediation = moved.status;
-    output = engine::haptic_output(desired, tool_.tip_mm(), contact, config_.haptic);
-    if (contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
-        output.fault) {
-      enter_safe_state(SafeReason::EngineFault);
-    } else {
-      static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
-                                             touched_));
-      max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
-    }
-  }
+}
 
-  // The force: zero in the safe state (already written when it was entered) and while a held start
-  // waits for the hand, ramped in after a reset or the start.
-  if (safe_reason_ == SafeReason::None && waiting_for_hand_) {
-    write_zero_force();
-  } else if (safe_reason_ == SafeReason::None) {
-    double scale = 1.0;
-    if (ramping_) {
-      const double elapsed = static_cast<double>(now_ns - ramp_start_ns_) / kNsPerS;
-      scale = config_.ramp_time_s > 0.0 ? std::clamp(elapsed / config_.ramp_time_s, 0.0, 1.0) : 1.0;
-      ramping_ = scale < 1.0;
-    }
-    const Eigen::Vector3d force = usable ? Eigen::Vector3d(scale * output.force_n) : Eigen::Vector3d::Zero();
-    const Eigen::Vector3d torque = usable ? Eigen::Vector3d(scale * output.torque_nmm) : Eigen::Vector3d::Zero();
-    last_command_ = {{force.x(), force.y(), force.z()},
-                     {torque.x(), torque.y()},
-                     static_cast<std::uint32_t>(cycle_),
-                     usable};
-    max_force_n_ = std::max(max_force_n_, force.norm());
-    if (device_.write_command(last_command_).status == hal::WriteStatus::Fault) {
-      enter_safe_state(SafeReason::DeviceFault);
-    }
+Controller::EngineOutcome Controller::run_engine(bool usable) {
+  // The device's tip in the world, the contact there, the virtual tool towards it.
+  EngineOutcome outcome{position_of(sample_),
+                        Eigen::Vector3d::Zero(),
+                        {engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()},
+                        {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false},
+                        engine::RemediationStatus::Stuck};
+  outcome.desired_tip_mm = motion::device_to_world(config_.frames, outcome.device_mm);
+  if (safe_reason_ != SafeReason::None || !usable || waiting_for_hand_) {
+    return outcome;
+  }
+  // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
+  // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
+  const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
+  if (std::isfinite(config_.max_axis_move_mm) && std::isfinite(config_.max_total_move_mm)) {
+    tool_.limit_speed(backlog_scale * config_.max_axis_move_mm, backlog_scale * config_.max_total_move_mm);
+  }
+  const Eigen::Vector3d& desired = outcome.desired_tip_mm;
+  outcome.contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
+  const engine::RemediationResult moved = tool_.step(desired, outcome.contact, config_.contact);
+  outcome.remediation = moved.status;
+  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic);
+  if (outcome.contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
+      outcome.output.fault) {
+    enter_safe_state(SafeReason::EngineFault);
   } else {
-    write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
+    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
+                                           touched_));
+    max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
   }
+  return outcome;
+}
 
+void Controller::write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output) {
+  // Zero in the safe state (already written when it was entered) and while a held start waits for
+  // the hand, ramped in after a reset or the start.
+  if (safe_reason_ != SafeReason::None || waiting_for_hand_) {
+    write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
+    return;
+  }
+  double scale = 1.0;
+  if (ramping_) {
+    const double elapsed = static_cast<double>(now_ns - ramp_start_ns_) / kNsPerS;
+    scale = config_.ramp_time_s > 0.0 ? std::clamp(elapsed / config_.ramp_time_s, 0.0, 1.0) : 1.0;
+    ramping_ = scale < 1.0;
+  }
+  const Eigen::Vector3d force = usable ? Eigen::Vector3d(scale * output.force_n) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d torque = usable ? Eigen::Vector3d(scale * output.torque_nmm) : Eigen::Vector3d::Zero();
+  last_command_ = {{force.x(), force.y(), force.z()},
+                   {torque.x(), torque.y()},
+                   static_cast<std::uint32_t>(cycle_),
+                   usable};
+  max_force_n_ = std::max(max_force_n_, force.norm());
+  if (device_.write_command(last_command_).status == hal::WriteStatus::Fault) {
+    enter_safe_state(SafeReason::DeviceFault);
+  }
+}
+
+void Controller::publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, const EngineOutcome& outcome) {
+  if (!rings_.journal.push(build_journal_record(now_ns))) {
+    enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
+  }
+  // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
+  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
+  copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
+  if (!rings_.machine.push(handoff)) {
+    enter_safe_state(SafeReason::MachineFault);
+  }
+  // Last, so that it shows the safe state the journal and the handoff may have just entered.
+  if (!rings_.telemetry.push(build_telemetry(now_ns, deadline_ns, outcome))) {
+    ++counters_.telemetry_dropped;
+  }
+}
+
+JournalRecord Controller::build_journal_record(hal::MonotonicNs now_ns) const {
   // The read as the device gave it (a replay feeds it back to the cycle), else the last sample used.
   const hal::HapticSample& recorded = read_.status == hal::ReadStatus::Fresh ? read_sample_ : sample_;
   JournalRecord record{};
@@ -326,37 +361,33 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   record.read_reason = read_.reason;
   record.fresh = fresh_;
   copy3(tool_.tip_mm(), record.virtual_tip_mm);
-  record.safe_reason = safe_reason_;  // as it stands before the machine handoff below
+  record.safe_reason = safe_reason_;  // as it stands before the machine handoff
   record.touched_triangles = static_cast<std::uint32_t>(touched_.count());
   for (int i = 0; i < 3; ++i) {
     record.force_n[i] = static_cast<float>(last_command_.force_n[i]);
   }
-  if (!rings_.journal.push(record)) {
-    enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
-  }
+  return record;
+}
 
-  // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
-  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
-  copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
-  if (!rings_.machine.push(handoff)) {
-    enter_safe_state(SafeReason::MachineFault);
-  }
-
+Telemetry Controller::build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
+                                      const EngineOutcome& outcome) const {
+  Telemetry telemetry{};
   telemetry.cycle = cycle_;
   telemetry.time_ns = now_ns;
-  copy3(device, telemetry.device_mm);
-  copy3(desired, telemetry.desired_tip_mm);
+  copy3(outcome.device_mm, telemetry.device_mm);
+  copy3(outcome.desired_tip_mm, telemetry.desired_tip_mm);
   copy3(tool_.tip_mm(), telemetry.virtual_tip_mm);
   for (int i = 0; i < 3; ++i) {
     telemetry.force_n[i] = last_command_.force_n[i];
   }
-  telemetry.max_depth_mm = contact.max_depth_mm;
+  telemetry.max_depth_mm = outcome.contact.max_depth_mm;
   telemetry.touched_triangles = static_cast<std::uint32_t>(touched_.count());
+  telemetry.remediation = outcome.remediation;
   telemetry.safe_reason = safe_reason_;
   telemetry.reset_requests = static_cast<std::uint32_t>(counters_.resets_accepted + counters_.resets_refused);
   telemetry.last_reset = last_reset_;
   telemetry.device_still_s = static_cast<double>(now_ns - still_since_ns_) / kNsPerS;
-  telemetry.device_to_tool_mm = (device - motion::world_to_device(config_.frames, tool_.tip_mm())).norm();
+  telemetry.device_to_tool_mm = (outcome.device_mm - motion::world_to_device(config_.frames, tool_.tip_mm())).norm();
   telemetry.wakeup_ns = now_ns - deadline_ns;
   telemetry.last_compute_ns = last_compute_ns_;
   telemetry.coupling_n_per_device_mm = config_.haptic.coupling_n_per_device_mm;
@@ -365,10 +396,7 @@ CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_
   telemetry.parameter_requests = parameter_requests_;
   telemetry.last_parameter = last_parameter_;
   telemetry.last_parameter_outcome = last_parameter_outcome_;
-  if (!rings_.telemetry.push(telemetry)) {
-    ++counters_.telemetry_dropped;
-  }
-  return safe_reason_ == SafeReason::None ? CycleStatus::Running : CycleStatus::SafeState;
+  return telemetry;
 }
 
 void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns) {

@@ -1,6 +1,7 @@
-// Controller: the 1 kHz cycle. One step() per period: commands in, read the device sample, check it,
-// map it to the world, query and remediate, write the force, hand the virtual tool to the machine
-// side, publish telemetry and the journal; and the safe state, latched, with its reset rule.
+// Controller: the 1 kHz cycle. One step() per period: commands in, read the device sample and check
+// it, the engine (map it to the world, query and remediate), write the force, publish (the journal
+// record, the virtual tool to the machine side, telemetry); and the safe state, latched, with its
+// reset rule.
 #pragma once
 
 #include <cstdint>
@@ -117,8 +118,31 @@ class Controller {
   // The reset rule's hand: still long enough, near enough the virtual tool (Accepted when both).
   [[nodiscard]] ResetOutcome hand_held_near_tool(hal::MonotonicNs now_ns) const;
   [[nodiscard]] ParameterOutcome set_parameter(CommandKind kind, double value);
+  // What the engine made of this cycle's sample, for the force and the telemetry.
+  struct EngineOutcome {
+    Eigen::Vector3d device_mm;       // the sample in use, device space
+    Eigen::Vector3d desired_tip_mm;  // it in the world: where the hand wants the tool
+    engine::ContactResult contact;   // at the desired pose (none when the engine did not run)
+    engine::HapticOutput output;     // unramped force and torque (zero when the engine did not run)
+    engine::RemediationStatus remediation;
+  };
+
+  // step()'s parts, in its order. Each real-time safe, as step() is.
+  // The cycle's count, its wake-up latency and the periods it missed.
+  void begin_cycle(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns);
   // Reads the device and checks the sample; false when the cycle must not render force.
   [[nodiscard]] bool read_device(hal::MonotonicNs now_ns);
+  // Ends a held start once the hand is held still near the tool.
+  void release_held_start(hal::MonotonicNs now_ns, bool usable);
+  // Contact, remediation and force at the sample, when the cycle renders force (else all zero).
+  [[nodiscard]] EngineOutcome run_engine(bool usable);
+  // The force to the device: ramped in, or zero in the safe state and a held start.
+  void write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output);
+  // The journal record, the machine handoff and the telemetry, in that order.
+  void publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, const EngineOutcome& outcome);
+  [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
+  [[nodiscard]] Telemetry build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
+                                          const EngineOutcome& outcome) const;
 
   const tables::PartTables& part_;
   hal::HapticDevice& device_;

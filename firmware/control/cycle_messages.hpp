@@ -8,6 +8,7 @@
 #include "firmware/control/spsc_ring.hpp"
 #include "firmware/stencil/virtual_tool.hpp"
 #include "hal/haptic_device.hpp"
+#include "hal/machine_link.hpp"
 
 namespace stencil::control {
 
@@ -26,6 +27,24 @@ struct Command {
   CommandKind kind;
   double value = 0.0;  // the Set* commands' new value
 };
+
+// The operator's parameter a Set* command sets, by the name the display uses in its requests and
+// its state feed ("coupling", "force_limit", "speed_limit"); "none" for the other commands.
+[[nodiscard]] constexpr const char* parameter_name(CommandKind kind) {
+  switch (kind) {
+    case CommandKind::SetCoupling:
+      return "coupling";
+    case CommandKind::SetForceLimit:
+      return "force_limit";
+    case CommandKind::SetSpeedLimit:
+      return "speed_limit";
+    case CommandKind::Reset:
+    case CommandKind::Stop:
+    case CommandKind::JournalFailed:
+      break;
+  }
+  return "none";
+}
 
 // What the cycle made of the newest Set* command.
 enum class ParameterOutcome : std::uint8_t {
@@ -86,14 +105,16 @@ struct MachineHandoff {
 // From the machine side, when something happens there.
 enum class MachineEventKind : std::uint8_t {
   Fault,    // the link latched a fault: the cycle enters the safe state
-  Stopped,  // the machine is stopped (after a safe state): for the record; fault 1: not confirmed off
+  Stopped,  // the machine is stopped (after a safe state): for the record
   JournalFailed,  // a target could not be recorded, so it was not sent: the cycle enters the safe state
   Backlog,        // how much of the path the mill has still to follow (each update): the cycle slows the tool
 };
 
 struct MachineEvent {
   MachineEventKind kind;
-  std::uint8_t fault;  // hal::MachineFault, for Fault; the path's fill in percent, for Backlog
+  hal::MachineFault fault = hal::MachineFault::None;  // Fault, JournalFailed: what the link had latched
+  bool stop_confirmed = false;                         // Stopped: the link confirmed spindle and drivers off
+  std::uint8_t backlog_percent = 0;                    // Backlog: how full the planner's path is, % of its capacity
 };
 
 // About 20 Hz is enough for people; the cycle pushes every cycle and a full ring drops (counted).

@@ -36,7 +36,7 @@ bool MachineSide::start_spindle(hal::MonotonicNs deadline_ns) {
 void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineEventKind report) {
   if (report_fault) {
     // A full event ring means the cycle already has a fault to read: it is in its safe state.
-    static_cast<void>(to_cycle_.push({report, static_cast<std::uint8_t>(link_.status().fault)}));
+    static_cast<void>(to_cycle_.push({.kind = report, .fault = link_.status().fault}));
   }
   if (state_ == MachineSideState::Stopped) {
     return;
@@ -45,7 +45,7 @@ void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineE
   link_.hold();
   // The link tries whatever fault it has latched, and says whether the outputs are confirmed off.
   stop_confirmed_ = link_.stop(deadline_ns).done;
-  static_cast<void>(to_cycle_.push({MachineEventKind::Stopped, static_cast<std::uint8_t>(stop_confirmed_ ? 0 : 1)}));
+  static_cast<void>(to_cycle_.push({.kind = MachineEventKind::Stopped, .stop_confirmed = stop_confirmed_}));
 }
 
 void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
@@ -72,7 +72,7 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   if (to_cycle_.size() < MachineEventRing::capacity() / 2) {
     const auto percent = static_cast<std::uint8_t>(
         std::min<std::size_t>(100, 100 * planner_.path_size() / motion::MachinePlanner::kPathCapacity));
-    static_cast<void>(to_cycle_.push({MachineEventKind::Backlog, percent}));
+    static_cast<void>(to_cycle_.push({.kind = MachineEventKind::Backlog, .backlog_percent = percent}));
   }
   if (safe_state) {
     stop(update_deadline_ns, false);

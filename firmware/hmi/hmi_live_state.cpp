@@ -23,19 +23,6 @@ nlohmann::json bins(const TimingBins& timing) {
   return {{"bin_us", TimingBins::kBinUs}, {"counts", timing.counts}, {"max_us", rounded(static_cast<double>(timing.max_ns) / 1000.0, 0.1)}};
 }
 
-const char* parameter_kind_name(control::CommandKind kind) {
-  switch (kind) {
-    case control::CommandKind::SetCoupling:
-      return "coupling";
-    case control::CommandKind::SetForceLimit:
-      return "force_limit";
-    case control::CommandKind::SetSpeedLimit:
-      return "speed_limit";
-    default:
-      return "none";
-  }
-}
-
 }  // namespace
 
 StockGrid coarse_stock(const control::CommandedStock& model) {
@@ -183,7 +170,7 @@ void LiveState::common(nlohmann::json& out) const {
                                        ? nlohmann::json(rounded(telemetry_.speed_limit_mm_per_s, 1e-4))
                                        : nlohmann::json(nullptr)},
                    {"requests", telemetry_.parameter_requests},
-                   {"last", parameter_kind_name(telemetry_.last_parameter)},
+                   {"last", control::parameter_name(telemetry_.last_parameter)},
                    {"last_outcome", control::parameter_outcome_name(telemetry_.last_parameter_outcome)}};
 }
 

@@ -16,18 +16,6 @@ std::string number(double value) {
 
 }  // namespace
 
-const char* parameter_name(Parameter parameter) {
-  switch (parameter) {
-    case Parameter::Coupling:
-      return "coupling";
-    case Parameter::ForceLimit:
-      return "force_limit";
-    case Parameter::SpeedLimit:
-      return "speed_limit";
-  }
-  return "unknown";
-}
-
 const char* parameter_unit(Parameter parameter) {
   switch (parameter) {
     case Parameter::Coupling:
@@ -92,7 +80,8 @@ bool parse_request(std::string_view text, Request& request, std::string& error) 
     return false;
   }
   if (!message.contains("value") || !message["value"].is_number()) {
-    error = std::string("\"set\" ") + parameter_name(parameter) + " needs a number \"value\" in " + parameter_unit(parameter);
+    error = std::string("\"set\" ") + control::parameter_name(command_kind(parameter)) + " needs a number \"value\" in " +
+            parameter_unit(parameter);
     return false;
   }
   request = Request{RequestKind::Set, parameter, message["value"].get<double>()};
@@ -106,7 +95,7 @@ std::string refusal(const Request& request, const HmiLimits& limits) {
   const double value = request.value;
   const std::string unit = parameter_unit(request.parameter);
   if (!std::isfinite(value) || value <= 0.0) {
-    return std::string(parameter_name(request.parameter)) + " must be a positive number of " + unit;
+    return std::string(control::parameter_name(command_kind(request.parameter))) + " must be a positive number of " + unit;
   }
   switch (request.parameter) {
     case Parameter::Coupling:

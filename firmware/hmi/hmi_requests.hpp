@@ -35,8 +35,8 @@ struct HmiLimits {
   double max_coupling_n_per_device_mm = 2.0;
 };
 
-[[nodiscard]] const char* parameter_name(Parameter parameter);  // "coupling", ...
 [[nodiscard]] const char* parameter_unit(Parameter parameter);  // "N/mm", "N", "mm/s"
+// The command that sets it; its name is control::parameter_name(command_kind(parameter)).
 [[nodiscard]] control::CommandKind command_kind(Parameter parameter);
 
 // False with `error` saying what was wrong and what was expected (never throws, whatever the bytes).

@@ -47,7 +47,7 @@ nlohmann::json reply(const char* type, const Request* request, const std::string
   if (request != nullptr) {
     out["request"] = request->kind == RequestKind::Reset ? "reset" : "set";
     if (request->kind == RequestKind::Set) {
-      out["name"] = parameter_name(request->parameter);
+      out["name"] = control::parameter_name(command_kind(request->parameter));
       out["value"] = request->value;
     }
   }

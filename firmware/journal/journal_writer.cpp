@@ -10,6 +10,7 @@
 #include <zlib.h>
 
 #include "firmware/journal/journal_bytes.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
 
 namespace stencil::journal {
 namespace {
@@ -163,11 +164,7 @@ bool JournalWriter::write_machine_commands_locked() {
 }
 
 void JournalWriter::wait_for_machine_commands(std::chrono::nanoseconds most) {
-  timespec until{};
-  clock_gettime(CLOCK_MONOTONIC, &until);
-  const std::int64_t ns = static_cast<std::int64_t>(until.tv_nsec) + most.count();
-  until.tv_sec += static_cast<time_t>(ns / 1'000'000'000);
-  until.tv_nsec = static_cast<long>(ns % 1'000'000'000);
+  const timespec until = hal::posix_clock::monotonic_timespec(hal::posix_clock::monotonic_now_ns() + most.count());
   while (sem_clockwait(&machine_queued_signal_, CLOCK_MONOTONIC, &until) != 0 && errno == EINTR) {
   }
   while (sem_trywait(&machine_queued_signal_) == 0) {

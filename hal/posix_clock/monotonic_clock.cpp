@@ -1,22 +1,29 @@
-// CLOCK_MONOTONIC behind the Clock interface.
+// CLOCK_MONOTONIC: now, and absolute sleeps.
 #include "hal/posix_clock/monotonic_clock.hpp"
 
 #include <cerrno>
-#include <ctime>
 
 namespace stencil::hal::posix_clock {
 
-MonotonicNs MonotonicClock::now_ns() const {
-  timespec now{};
-  clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<MonotonicNs>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
+namespace {
+constexpr MonotonicNs kNsPerS = 1'000'000'000;
 }
 
-void MonotonicClock::sleep_until_ns(MonotonicNs deadline_ns) {
+MonotonicNs monotonic_now_ns() {
+  timespec now{};
+  clock_gettime(CLOCK_MONOTONIC, &now);
+  return static_cast<MonotonicNs>(now.tv_sec) * kNsPerS + now.tv_nsec;
+}
+
+timespec monotonic_timespec(MonotonicNs deadline_ns) {
+  return {static_cast<time_t>(deadline_ns / kNsPerS), static_cast<long>(deadline_ns % kNsPerS)};
+}
+
+void sleep_until_monotonic_ns(MonotonicNs deadline_ns) {
   if (deadline_ns <= 0) {
     return;
   }
-  const timespec deadline{static_cast<time_t>(deadline_ns / 1'000'000'000), static_cast<long>(deadline_ns % 1'000'000'000)};
+  const timespec deadline = monotonic_timespec(deadline_ns);
   while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
   }
 }

@@ -10,12 +10,6 @@ namespace {
 constexpr int kServicePeriodMs = 1;
 }
 
-hal::MonotonicNs FakeCy545Runner::monotonic_now_ns() {
-  timespec now{};
-  clock_gettime(CLOCK_MONOTONIC, &now);
-  return static_cast<hal::MonotonicNs>(now.tv_sec) * 1'000'000'000 + now.tv_nsec;
-}
-
 FakeCy545Runner::FakeCy545Runner(FakeCy545& fake) : fake_(fake), thread_([this] { run(); }) {}
 
 FakeCy545Runner::~FakeCy545Runner() {
@@ -28,7 +22,7 @@ void FakeCy545Runner::run() {
     int fd = -1;
     {
       const std::lock_guard<std::mutex> lock(mutex_);
-      fake_.step(monotonic_now_ns());
+      fake_.step(hal::posix_clock::monotonic_now_ns());
       fd = fake_.master_fd();
     }
     if (fd >= 0) {

@@ -6,14 +6,15 @@
 #include <mutex>
 #include <thread>
 
-#include "hal/clock.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"
 
 namespace stencil::sim::cy545 {
 
 class FakeCy545Runner {
  public:
-  // Starts the thread. The fake must have been made with a start time from monotonic_now_ns().
+  // Starts the thread. The fake must have been made with a start time from
+  // hal::posix_clock::monotonic_now_ns(), the clock the thread steps it on.
   explicit FakeCy545Runner(FakeCy545& fake);
   // Stops and joins the thread.
   ~FakeCy545Runner();
@@ -27,9 +28,6 @@ class FakeCy545Runner {
     const std::lock_guard<std::mutex> lock(mutex_);
     return inspect(fake_);
   }
-
-  // CLOCK_MONOTONIC in ns.
-  static hal::MonotonicNs monotonic_now_ns();
 
  private:
   void run();

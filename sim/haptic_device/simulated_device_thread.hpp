@@ -1,5 +1,6 @@
 // SimulatedDeviceThread: runs a SimulatedHapticDevice's step() on its own thread at a fixed period
-// (1 kHz by default) on CLOCK_MONOTONIC, as the device's controller would. Not real-time code.
+// (1 kHz by default) on CLOCK_MONOTONIC (hal::posix_clock::monotonic_now_ns() is the time base it
+// passes to step()), as the device's controller would. Not real-time code.
 #pragma once
 
 #include <atomic>
@@ -10,9 +11,6 @@
 #include "sim/haptic_device/simulated_haptic_device.hpp"
 
 namespace stencil::sim {
-
-// CLOCK_MONOTONIC in nanoseconds: the time base the thread passes to step().
-[[nodiscard]] hal::MonotonicNs monotonic_now_ns();
 
 class SimulatedDeviceThread {
  public:

@@ -221,7 +221,7 @@ TEST(Controller, AForceWriteThatFailsEntersTheSafeState) {
 TEST(Controller, AMachineFaultEntersTheSafeState) {
   Bench bench;
   bench.cycles(20);
-  CHECK(bench.machine_events.push({MachineEventKind::Fault, 4}));
+  CHECK(bench.machine_events.push({.kind = MachineEventKind::Fault, .fault = hal::MachineFault::Timeout}));
   CHECK(bench.cycle() == CycleStatus::SafeState);
   check_safe(bench, SafeReason::MachineFault);
 }
@@ -438,7 +438,7 @@ TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtNinetyPercentHoldsIt) {
   Bench bench(c);
   bench.cycles(5);
   const auto moved_in_a_cycle = [&bench](std::uint8_t backlog_percent) {
-    CHECK(bench.machine_events.push({MachineEventKind::Backlog, backlog_percent}));
+    CHECK(bench.machine_events.push({.kind = MachineEventKind::Backlog, .backlog_percent = backlog_percent}));
     const Eigen::Vector3d before = bench.controller->virtual_tip_mm();
     CHECK(bench.cycle() == CycleStatus::Running);
     return (bench.controller->virtual_tip_mm() - before).cwiseAbs().sum();

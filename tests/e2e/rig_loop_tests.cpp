@@ -42,7 +42,7 @@ struct FakeRig {
   tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
   tables::PartTables part{};
   sim::SimulatedMill mill{sim::sherline_mill_config()};
-  sim::cy545::FakeCy545 fake{mill, sim::cy545::FakeCy545Runner::monotonic_now_ns()};
+  sim::cy545::FakeCy545 fake{mill, hal::posix_clock::monotonic_now_ns()};
   std::unique_ptr<sim::cy545::FakeCy545Runner> fake_runner;
   hal::cy545::SerialPort port;
   hal::posix_clock::MonotonicClock clock;
@@ -70,7 +70,7 @@ struct FakeRig {
     hal::cy545::Cy545Config config;
     config.homing_rate = 20000;  // the fake homes in a fraction of a second
     config.homing_slow_rate = 5000;
-    config.reply_timeout_ns = 250'000'000;  // the fake is a thread on a host that is not real-time
+    config.reply_timeout_ns = 1'000'000'000;  // the fake is a thread on a host that is not real-time (and CI's sanitizers)
     link = std::make_unique<hal::cy545::Cy545Link>(port, clock, config);
     window = hal::pio_shared_memory::SharedWindowMapping::create_memfd("rig-loop-tests", error);
     CHECK(window != nullptr);
@@ -79,7 +79,7 @@ struct FakeRig {
     // is a thread on a host that is not real-time (as stale_periods and overrun_limit below).
     device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, pose, 200'000'000);
     host = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
-    device->step(sim::cy545::FakeCy545Runner::monotonic_now_ns());
+    device->step(hal::posix_clock::monotonic_now_ns());
     device_thread = std::thread([this] {
       // The device's own loop is hard real time on its card: SCHED_FIFO here where allowed, so
       // the host's noise does not make it look stale.
@@ -91,7 +91,7 @@ struct FakeRig {
         next += std::chrono::milliseconds(1);
         std::this_thread::sleep_until(next);
         if (!device_frozen.load()) {
-          device->step(sim::cy545::FakeCy545Runner::monotonic_now_ns());
+          device->step(hal::posix_clock::monotonic_now_ns());
         }
       }
     });
@@ -135,7 +135,7 @@ struct FakeRig {
   }
 };
 
-rig::PeriodicRunner unprivileged_runner() {
+runtime::PeriodicRunner unprivileged_runner() {
   return [](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
             const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle, std::string& refused) {
     const app::RealtimeSetup setup = app::run_periodic({80, -1, false}, period_ns, stop, cycle, [](const std::string&) {});
@@ -180,7 +180,7 @@ TEST(RigLoop, ADeviceThatFreezesIsASafeStateWithTheMillStoppedAndNoForceUntilThe
   // The last thing the host wrote to the device: no force, enable off.
   rig.stop_device_thread();
   rig.device_frozen.store(false);
-  rig.device->step(sim::cy545::FakeCy545Runner::monotonic_now_ns());
+  rig.device->step(hal::posix_clock::monotonic_now_ns());
   const sim::DeviceOutput output = rig.device->output();
   CHECK_FALSE(output.force_applied);
   DOUBLES_EQUAL(0.0, std::hypot(output.force_n[0], output.force_n[1], output.force_n[2]), 0.0);

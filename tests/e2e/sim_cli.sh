@@ -4,7 +4,8 @@
 #
 # usage: sim_cli.sh CASE STENCIL_SIM WORK_ROOT
 # Each case runs in a fresh directory under WORK_ROOT, removed when it passes and kept, with its path
-# printed, when it fails. Exit 0 pass, 1 fail. Only bash, coreutils, grep, sed and awk.
+# printed, when it fails (SIM_CLI_KEEP=1 keeps it when it passes too: toolchain/same-behaviour.sh
+# compares what two builds left there). Exit 0 pass, 1 fail. Only bash, coreutils, grep, sed and awk.
 set -uo pipefail
 
 if [ "$#" -ne 3 ]; then
@@ -637,5 +638,7 @@ if [ "$failures" -gt 0 ]; then
   echo "$failures failure(s); the case's files are in $work" >&2
   exit 1
 fi
-cd / && rm -rf "$work"
+if [ "${SIM_CLI_KEEP:-0}" != 1 ]; then
+  cd / && rm -rf "$work"
+fi
 exit 0

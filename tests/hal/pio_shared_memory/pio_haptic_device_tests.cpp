@@ -13,6 +13,7 @@
 #include "hal/pio_shared_memory/pio_device_side.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/seqlock.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/haptic_device/pio_device_link.hpp"
 #include "sim/haptic_device/simulated_device_thread.hpp"
 #include "sim/haptic_device/simulated_haptic_device.hpp"
@@ -496,15 +497,15 @@ TEST(PioHapticDevice, NeverAcceptsATornSampleWhileTheSimulatedDeviceWritesAt1kHz
   // A watchdog far beyond any scheduling hiccup: this test is about consistency, not timing.
   pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
   sim::SimulatedDeviceThread device_thread(*device);
-  const hal::MonotonicNs end = sim::monotonic_now_ns() + 300 * kMs;
+  const hal::MonotonicNs end = hal::posix_clock::monotonic_now_ns() + 300 * kMs;
   int reads = 0;
   int fresh = 0;
   int inconsistent = 0;
   std::uint32_t previous_counter = 0;
   int went_backwards = 0;
-  while (sim::monotonic_now_ns() < end) {
+  while (hal::posix_clock::monotonic_now_ns() < end) {
     hal::HapticSample sample{};
-    const hal::ReadResult result = reader.read_sample(sim::monotonic_now_ns(), sample);
+    const hal::ReadResult result = reader.read_sample(hal::posix_clock::monotonic_now_ns(), sample);
     ++reads;
     if (result.status != ReadStatus::Fresh) continue;
     ++fresh;
@@ -532,8 +533,8 @@ TEST(PioHapticDevice, NeverAcceptsATornSampleFromAWriterHammeringTheWindow) {
   pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
   int fresh = 0;
   int inconsistent = 0;
-  const hal::MonotonicNs end = sim::monotonic_now_ns() + 5'000 * kMs;
-  while (fresh < 50000 && sim::monotonic_now_ns() < end) {
+  const hal::MonotonicNs end = hal::posix_clock::monotonic_now_ns() + 5'000 * kMs;
+  while (fresh < 50000 && hal::posix_clock::monotonic_now_ns() < end) {
     hal::HapticSample sample{};
     if (reader.read_sample(0, sample).status != ReadStatus::Fresh) continue;
     ++fresh;

@@ -18,7 +18,7 @@ TEST_GROUP(FakeCy545Runner) {
 };
 
 TEST(FakeCy545Runner, AnswersQueriesWithoutTheTestSteppingIt) {
-  FakeCy545 fake{mill, FakeCy545Runner::monotonic_now_ns()};
+  FakeCy545 fake{mill, stencil::hal::posix_clock::monotonic_now_ns()};
   FakeCy545Runner runner{fake};
   PtyTestClient client{fake.slave_path()};
   CHECK_TRUE(client.write_raw("\rN 10\r? N\r"));
@@ -26,7 +26,7 @@ TEST(FakeCy545Runner, AnswersQueriesWithoutTheTestSteppingIt) {
 }
 
 TEST(FakeCy545Runner, AMoveTakesAtLeastItsStepsOverRateOfWallTime) {
-  FakeCy545 fake{mill, FakeCy545Runner::monotonic_now_ns()};
+  FakeCy545 fake{mill, stencil::hal::posix_clock::monotonic_now_ns()};
   FakeCy545Runner runner{fake};
   PtyTestClient client{fake.slave_path()};
   const std::int64_t x0 = mill.axis_position_steps(Axis::x);

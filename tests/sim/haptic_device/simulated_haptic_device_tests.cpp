@@ -12,6 +12,7 @@
 
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/seqlock.hpp"
+#include "hal/posix_clock/monotonic_clock.hpp"
 #include "hal/socketcan/can_codec.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
@@ -288,20 +289,20 @@ TEST(SimulatedHapticDevice, OnItsOwnThreadZeroesForceSoonAfterTheHostStops) {
   PioRig rig;
   sim::SimulatedDeviceThread device_thread(rig.device());
   // Beat until the device has taken a command and drives it (bounded: a loaded machine is slow, not stuck).
-  const hal::MonotonicNs give_up = sim::monotonic_now_ns() + 2'000 * kMs;
+  const hal::MonotonicNs give_up = hal::posix_clock::monotonic_now_ns() + 2'000 * kMs;
   hal::MonotonicNs last_write_ns = 0;
-  while (!rig.device().output().force_applied && sim::monotonic_now_ns() < give_up) {
-    last_write_ns = sim::monotonic_now_ns();  // the device cannot see this beat any earlier
+  while (!rig.device().output().force_applied && hal::posix_clock::monotonic_now_ns() < give_up) {
+    last_write_ns = hal::posix_clock::monotonic_now_ns();  // the device cannot see this beat any earlier
     rig.send_plainly(push(2.0));
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
   CHECK_TRUE(rig.device().output().force_applied);
 
   // The host goes silent. The trip comes after the watchdog time, never before; generous bound on how late.
-  while (rig.device().output().force_applied && sim::monotonic_now_ns() < last_write_ns + 2'000 * kMs) {
+  while (rig.device().output().force_applied && hal::posix_clock::monotonic_now_ns() < last_write_ns + 2'000 * kMs) {
     std::this_thread::sleep_for(std::chrono::milliseconds(1));
   }
-  const hal::MonotonicNs zeroed_after_ns = sim::monotonic_now_ns() - last_write_ns;
+  const hal::MonotonicNs zeroed_after_ns = hal::posix_clock::monotonic_now_ns() - last_write_ns;
   device_thread.stop();
   CHECK_FALSE(rig.device().output().force_applied);
   CHECK_TRUE(rig.device().output().watchdog_tripped);

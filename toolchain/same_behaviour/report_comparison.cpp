@@ -1,0 +1,81 @@
+// Report comparison: a walk over both JSON trees at once.
+#include "toolchain/same_behaviour/report_comparison.hpp"
+
+#include <regex>
+
+namespace stencil::same_behaviour {
+namespace {
+
+// A value for a one-line message: its JSON text, cut short when long (an array of run endings).
+std::string shown(const nlohmann::json& value) {
+  constexpr std::size_t kLongest = 80;
+  std::string text = value.dump();
+  if (text.size() > kLongest) {
+    text = text.substr(0, kLongest - 3) + "...";
+  }
+  return text;
+}
+
+std::string child(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+
+void compare(const nlohmann::json& older, const nlohmann::json& newer, const std::string& path, ReportComparison& out) {
+  if (older.is_object() && newer.is_object()) {
+    for (const auto& [key, value] : older.items()) {
+      if (is_wall_clock_field(key)) {
+        continue;
+      }
+      const auto found = newer.find(key);
+      if (found == newer.end()) {
+        out.changed.push_back(child(path, key) + ": removed (was " + shown(value) + ")");
+      } else {
+        compare(value, *found, child(path, key), out);
+      }
+    }
+    for (const auto& [key, value] : newer.items()) {
+      if (!is_wall_clock_field(key) && !older.contains(key)) {
+        out.added.push_back(child(path, key) + " = " + shown(value));
+      }
+    }
+    return;
+  }
+  if (older.is_array() && newer.is_array()) {
+    if (older.size() != newer.size()) {
+      out.changed.push_back(path + ": " + std::to_string(older.size()) + " elements -> " + std::to_string(newer.size()) +
+                            " (" + shown(older) + " -> " + shown(newer) + ")");
+      return;
+    }
+    for (std::size_t i = 0; i < older.size(); ++i) {
+      compare(older[i], newer[i], path + "[" + std::to_string(i) + "]", out);
+    }
+    return;
+  }
+  if (older.is_string() && newer.is_string()) {
+    if (without_start_time(older.get<std::string>()) != without_start_time(newer.get<std::string>())) {
+      out.changed.push_back(path + ": " + shown(older) + " -> " + shown(newer));
+    }
+    return;
+  }
+  // Numbers compare exactly: the reports print doubles so that they read back to the same bits.
+  if (older != newer) {
+    out.changed.push_back((path.empty() ? std::string("the report") : path) + ": " + shown(older) + " -> " + shown(newer));
+  }
+}
+
+}  // namespace
+
+bool is_wall_clock_field(const std::string& key) {
+  return key == "wall_s" || key == "compute_us" || key == "memory_kb" || key.find("latency") != std::string::npos;
+}
+
+std::string without_start_time(const std::string& text) {
+  static const std::regex journal_name("stencil-sim-[0-9]{8}-[0-9]{6}\\.journal");
+  return std::regex_replace(text, journal_name, "stencil-sim-YYYYMMDD-HHMMSS.journal");
+}
+
+ReportComparison compare_reports(const nlohmann::json& older, const nlohmann::json& newer) {
+  ReportComparison out;
+  compare(older, newer, "", out);
+  return out;
+}
+
+}  // namespace stencil::same_behaviour
