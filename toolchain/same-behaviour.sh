@@ -39,41 +39,7 @@ die() {
 
 old_commit=$(git -C "$repo" rev-parse --verify --quiet "$1^{commit}") || die "$1: not a commit in $repo"
 old_name=$(git -C "$repo" rev-parse --short "$old_commit")
-
-# --- The two builds -------------------------------------------------------------------------------
-
-# The older commit in a worktree of its own (reused, moved to OLD_COMMIT, when one is there already).
-old_src=$out/old/src
-old_build=$out/old/build
-mkdir -p "$out/old"
-if git -C "$old_src" rev-parse --git-dir >/dev/null 2>&1 &&
-  [ "$(git -C "$old_src" rev-parse --show-toplevel)" = "$old_src" ]; then
-  git -C "$old_src" checkout --quiet --force --detach "$old_commit" || die "$old_src: cannot check out $1"
-else
-  # --force: the path may still be registered from a build/ that was removed since.
-  rm -rf "$old_src"
-  git -C "$repo" worktree add --quiet --force --detach "$old_src" "$old_commit" || die "cannot make a worktree of $1 in $old_src"
-fi
-
-# build DIR TARGET...: brings the targets up to date, its output in DIR/same-behaviour-build.log.
-build() {
-  local dir=$1 log=$1/same-behaviour-build.log
-  shift
-  if ! cmake --build "$dir" -j "$jobs" --target "$@" >"$log" 2>&1; then
-    tail -n 30 "$log" >&2
-    die "building $* in $dir failed (all of it in $log)"
-  fi
-}
-
-echo "same-behaviour: old is $(git -C "$repo" log -1 --format='%h (%s)' "$old_commit"), built in $old_build"
-# The older commit's own release preset, in a folder of ours.
-cmake -S "$old_src" -B "$old_build" --preset release >"$out/old/configure.log" 2>&1 ||
-  { tail -n 30 "$out/old/configure.log" >&2; die "configuring $old_src failed (all of it in $out/old/configure.log)"; }
-build "$old_build" stencil-sim
-echo "same-behaviour: new is this tree, built in $new_build"
 [ -f "$new_build/CMakeCache.txt" ] || die "$new_build: not a configured build (make build, or cmake --preset release)"
-build "$new_build" stencil-sim stencil-same-behaviour
-compare=$new_build/bin/stencil-same-behaviour
 
 # --- The jobs -------------------------------------------------------------------------------------
 
@@ -110,6 +76,40 @@ fi
 demo_line=$(sed -n '/^demo:/,/^$/p' "$repo/Makefile" | grep -m1 'build/bin/stencil-sim ') ||
   die "$repo/Makefile: no stencil-sim command under demo:"
 read -r -a demo_arguments <<<"$(echo "$demo_line" | sed -e 's|^[[:space:]]*build/bin/stencil-sim||' -e 's|build/demo/||g')"
+
+# --- The two builds -------------------------------------------------------------------------------
+
+# The older commit in a worktree of its own (reused, moved to OLD_COMMIT, when one is there already).
+old_src=$out/old/src
+old_build=$out/old/build
+mkdir -p "$out/old"
+if git -C "$old_src" rev-parse --git-dir >/dev/null 2>&1 &&
+  [ "$(git -C "$old_src" rev-parse --show-toplevel)" = "$old_src" ]; then
+  git -C "$old_src" checkout --quiet --force --detach "$old_commit" || die "$old_src: cannot check out $1"
+else
+  # --force: the path may still be registered from a build/ that was removed since.
+  rm -rf "$old_src"
+  git -C "$repo" worktree add --quiet --force --detach "$old_src" "$old_commit" || die "cannot make a worktree of $1 in $old_src"
+fi
+
+# build DIR TARGET...: brings the targets up to date, its output in DIR/same-behaviour-build.log.
+build() {
+  local dir=$1 log=$1/same-behaviour-build.log
+  shift
+  if ! cmake --build "$dir" -j "$jobs" --target "$@" >"$log" 2>&1; then
+    tail -n 30 "$log" >&2
+    die "building $* in $dir failed (all of it in $log)"
+  fi
+}
+
+echo "same-behaviour: old is $(git -C "$repo" log -1 --format='%h (%s)' "$old_commit"), built in $old_build"
+# The older commit's own release preset, in a folder of ours.
+cmake -S "$old_src" -B "$old_build" --preset release >"$out/old/configure.log" 2>&1 ||
+  { tail -n 30 "$out/old/configure.log" >&2; die "configuring $old_src failed (all of it in $out/old/configure.log)"; }
+build "$old_build" stencil-sim
+echo "same-behaviour: new is this tree, built in $new_build"
+build "$new_build" stencil-sim stencil-same-behaviour
+compare=$new_build/bin/stencil-same-behaviour
 
 # run_jobs SIDE SIM: every job with SIM; its folders end up in runs/SIDE/<job> and each job's log
 # (sim_cli.sh's account of its runs) and exit status in runs/SIDE/log. Both sides run in the same
