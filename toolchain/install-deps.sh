@@ -49,7 +49,7 @@ packages=(
 )
 # The display's page is built with npm (three.js and esbuild, pinned by its package-lock.json): the
 # machine's own Node.js and npm when it has them, else Debian's (Node 18 on Debian 12: every package
-# the lock file pins accepts it, and firmware/hmi/page/check-engines.cjs refuses a Node that some
+# the lock file pins accepts it, and firmware/services/hmi/page/check-engines.cjs refuses a Node that some
 # pinned package does not, before the page is built and before the browser test).
 if ! command -v npm >/dev/null 2>&1 || ! command -v node >/dev/null 2>&1; then
   packages+=(nodejs npm)

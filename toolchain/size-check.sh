@@ -3,7 +3,7 @@
 # readability-function-size (Debian's clang-tidy, only that check) counts each function's lines,
 # body and comments included, lambdas counted in the function that holds them; a function fails when
 # it has more lines than its limit:
-#   - a program's main() (firmware/app/*_main.cpp):           at most MAIN_LIMIT (150) lines;
+#   - a program's main() (firmware/programs/*_main.cpp):           at most MAIN_LIMIT (150) lines;
 #   - every other function in those files, the runtime's and the boards' (firmware/runtime/*.cpp,
 #     board/*/*.cpp, the programs' other files): at most FUNCTION_LIMIT (80) lines. A helper beside
 #     main() is held to the runtime's limit: only main() itself gets the programs' larger one.
@@ -24,8 +24,8 @@ cd "$(dirname "$0")/.."
 # The file sets, in one place (globs from the repository root). When the runtime moves to its own
 # folder, change `runtime` (and `programs` if the mains move). A glob that matches nothing is skipped
 # (firmware/runtime/ has no .cpp yet); a file that matches must be in the compile database.
-programs=(firmware/app/*_main.cpp)
-runtime=(firmware/runtime/*.cpp board/sim/*.cpp board/sherline_suzuki/*.cpp firmware/app/*.cpp)
+programs=(firmware/programs/*_main.cpp)
+runtime=(firmware/runtime/*.cpp board/sim/*.cpp board/sherline_suzuki/*.cpp firmware/programs/*.cpp)
 MAIN_LIMIT=150
 FUNCTION_LIMIT=80
 

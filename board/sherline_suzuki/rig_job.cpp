@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "board/sherline_suzuki/rig_constants.hpp"
-#include "firmware/control/controller.hpp"
-#include "firmware/control/loop_statistics.hpp"
-#include "firmware/control/machine_side.hpp"
-#include "firmware/journal/journal_drain.hpp"
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/control/loop_statistics.hpp"
+#include "firmware/core/control/machine_side.hpp"
+#include "firmware/services/journal/journal_drain.hpp"
 
 namespace stencil::board::sherline_suzuki {
 namespace {

@@ -11,15 +11,15 @@
 
 #include <Eigen/Core>
 
-#include "firmware/control/commanded_stock.hpp"
-#include "firmware/control/controller.hpp"
-#include "firmware/control/display_feed.hpp"
-#include "firmware/control/safe_state.hpp"
-#include "firmware/journal/job_history.hpp"
-#include "firmware/journal/journal_writer.hpp"
-#include "firmware/motion/machine_frames.hpp"
+#include "firmware/core/control/commanded_stock.hpp"
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/control/display_feed.hpp"
+#include "firmware/core/control/safe_state.hpp"
+#include "firmware/services/journal/job_history.hpp"
+#include "firmware/services/journal/journal_writer.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/runtime/periodic_runner.hpp"
-#include "firmware/tables/part_tables.hpp"
+#include "firmware/core/tables/part_tables.hpp"
 #include "hal/clock.hpp"
 #include "hal/haptic_device.hpp"
 #include "hal/machine_link.hpp"

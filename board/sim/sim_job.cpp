@@ -23,10 +23,10 @@
 #include <unistd.h>
 
 #include "board/sim/device_process.hpp"
-#include "firmware/control/controller.hpp"
-#include "firmware/control/loop_statistics.hpp"
-#include "firmware/control/machine_side.hpp"
-#include "firmware/journal/journal_drain.hpp"
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/control/loop_statistics.hpp"
+#include "firmware/core/control/machine_side.hpp"
+#include "firmware/services/journal/journal_drain.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"

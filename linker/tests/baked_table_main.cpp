@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <span>
 
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 
 // From the emitted stencil_table_hex_prism.cpp.
 extern const unsigned char stencil_table_hex_prism[];

@@ -3,7 +3,7 @@
 // the same inputs bit for bit whatever transport the job ran over; its commands are taken and kept.
 #pragma once
 
-#include "firmware/control/cycle_messages.hpp"
+#include "firmware/core/control/cycle_messages.hpp"
 #include "hal/haptic_device.hpp"
 
 namespace stencil::sim {

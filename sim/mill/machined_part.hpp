@@ -11,8 +11,8 @@
 
 #include <Eigen/Core>
 
-#include "firmware/motion/machine_frames.hpp"
-#include "firmware/tables/part_tables.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
+#include "firmware/core/tables/part_tables.hpp"
 #include "sim/mill/simulated_mill.hpp"
 #include "sim/mill/stock_zmap.hpp"
 

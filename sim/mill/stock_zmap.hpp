@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "firmware/geometry/tool_spec.hpp"
+#include "firmware/core/geometry/tool_spec.hpp"
 
 namespace stencil::sim {
 

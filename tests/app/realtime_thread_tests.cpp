@@ -11,7 +11,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include "firmware/app/realtime_thread.hpp"
+#include "firmware/runtime/realtime_thread.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>

@@ -9,9 +9,9 @@
 #include <string>
 #include <vector>
 
-#include "firmware/stencil/contact_query.hpp"
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/bench/fcl_reference.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 #include "toolchain/tablegen/table_generator.hpp"

@@ -4,7 +4,7 @@
 #include <limits>
 #include <vector>
 
-#include "firmware/control/commanded_stock.hpp"
+#include "firmware/core/control/commanded_stock.hpp"
 
 #include <CppUTest/TestHarness.h>
 

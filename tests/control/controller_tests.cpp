@@ -5,8 +5,8 @@
 #include <limits>
 #include <memory>
 
-#include "firmware/control/controller.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/fakes/fake_haptic_device.hpp"
 #include "tests/support/sample_tables.hpp"
 

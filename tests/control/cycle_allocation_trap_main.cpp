@@ -6,8 +6,8 @@
 #include <cstdio>
 #include <memory>
 
-#include "firmware/control/controller.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "sim/haptic_device/direct_haptic_device.hpp"
 #include "tests/support/heap_trap.hpp"
 #include "tests/support/sample_tables.hpp"

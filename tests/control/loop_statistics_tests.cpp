@@ -1,5 +1,5 @@
 // The cycle's histograms: bins of 1 us, an overflow bin, quantiles that never understate.
-#include "firmware/control/loop_statistics.hpp"
+#include "firmware/core/control/loop_statistics.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -6,8 +6,8 @@
 #include <memory>
 #include <vector>
 
-#include "firmware/control/machine_side.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/control/machine_side.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/fakes/spy_machine_link.hpp"
 #include "tests/support/sample_tables.hpp"
 

@@ -2,7 +2,7 @@
 #include <cstdint>
 #include <thread>
 
-#include "firmware/control/spsc_ring.hpp"
+#include "firmware/core/control/spsc_ring.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -8,11 +8,11 @@
 #include <cstdio>
 #include <vector>
 
-#include "firmware/motion/machine_planner.hpp"
-#include "firmware/motion/speed_limit.hpp"
-#include "firmware/stencil/sweep.hpp"
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/motion/machine_planner.hpp"
+#include "firmware/core/motion/speed_limit.hpp"
+#include "firmware/core/stencil/sweep.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"

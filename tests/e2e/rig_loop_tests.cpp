@@ -15,9 +15,9 @@
 #include <sched.h>
 
 #include "board/sherline_suzuki/rig_job.hpp"
-#include "firmware/journal/job_history.hpp"
-#include "firmware/app/realtime_thread.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/services/journal/job_history.hpp"
+#include "firmware/runtime/realtime_thread.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"

@@ -11,7 +11,7 @@
 
 #include <unistd.h>
 
-#include "firmware/journal/journal_storage.hpp"
+#include "firmware/services/journal/journal_storage.hpp"
 
 namespace stencil::test {
 

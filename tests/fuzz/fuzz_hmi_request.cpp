@@ -9,9 +9,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/hmi/hmi_requests.hpp"
-#include "firmware/hmi/hmi_server.hpp"
-#include "firmware/tables/part_tables.hpp"
+#include "firmware/services/hmi/hmi_requests.hpp"
+#include "firmware/services/hmi/hmi_server.hpp"
+#include "firmware/core/tables/part_tables.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
 
 using stencil::fuzz::require;

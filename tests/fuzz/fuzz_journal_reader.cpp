@@ -8,8 +8,8 @@
 
 #include <zlib.h>
 
-#include "firmware/journal/journal_format.hpp"
-#include "firmware/journal/journal_reader.hpp"
+#include "firmware/services/journal/journal_format.hpp"
+#include "firmware/services/journal/journal_reader.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
 
 using stencil::fuzz::require;

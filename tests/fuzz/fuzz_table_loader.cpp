@@ -7,8 +7,8 @@
 #include <new>
 #include <span>
 
-#include "firmware/tables/table_format.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/tables/table_format.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
 
 using stencil::fuzz::require;

@@ -7,7 +7,7 @@
 
 #include <Eigen/LU>
 
-#include "firmware/geometry/kdop14.hpp"
+#include "firmware/core/geometry/kdop14.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>

@@ -5,8 +5,8 @@
 #include <limits>
 #include <random>
 
-#include "firmware/geometry/meridian_box.hpp"
-#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/meridian_box.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "tests/support/sample_tools.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

@@ -5,8 +5,8 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/geometry/tool_bound.hpp"
-#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/tool_bound.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "tests/support/sample_tools.hpp"
 #include "tests/support/tool_profile_reference.hpp"
 

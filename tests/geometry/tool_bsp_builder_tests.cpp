@@ -3,8 +3,8 @@
 #include <cstring>
 #include <limits>
 
-#include "firmware/geometry/tool_bsp.hpp"
-#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "tests/support/sample_tools.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

@@ -8,8 +8,8 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/geometry/tool_bsp.hpp"
-#include "firmware/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "tests/support/sample_tools.hpp"
 #include "tests/support/tool_profile_reference.hpp"
 

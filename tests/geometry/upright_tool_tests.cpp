@@ -1,8 +1,8 @@
 // The upright tool's culling tests never cull what the BSP calls penetrating.
 #include <random>
 
-#include "firmware/geometry/tool_bsp_builder.hpp"
-#include "firmware/geometry/upright_tool.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/upright_tool.hpp"
 #include "tests/support/sample_tools.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

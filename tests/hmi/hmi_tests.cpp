@@ -22,12 +22,12 @@
 #include <civetweb.h>
 #include <nlohmann/json.hpp>
 
-#include "firmware/hmi/hmi_access.hpp"
-#include "firmware/hmi/hmi_live_state.hpp"
-#include "firmware/hmi/hmi_requests.hpp"
-#include "firmware/hmi/hmi_server.hpp"
-#include "firmware/motion/machine_frames.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/services/hmi/hmi_access.hpp"
+#include "firmware/services/hmi/hmi_live_state.hpp"
+#include "firmware/services/hmi/hmi_requests.hpp"
+#include "firmware/services/hmi/hmi_server.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

@@ -10,10 +10,10 @@
 
 #include <unistd.h>
 
-#include "firmware/journal/journal_drain.hpp"
-#include "firmware/journal/journal_format.hpp"
-#include "firmware/journal/journal_reader.hpp"
-#include "firmware/journal/journal_writer.hpp"
+#include "firmware/services/journal/journal_drain.hpp"
+#include "firmware/services/journal/journal_format.hpp"
+#include "firmware/services/journal/journal_reader.hpp"
+#include "firmware/services/journal/journal_writer.hpp"
 
 #include <CppUTest/TestHarness.h>
 

@@ -8,7 +8,7 @@
 
 #include <unistd.h>
 
-#include "firmware/journal/journal_writer.hpp"
+#include "firmware/services/journal/journal_writer.hpp"
 #include "tests/support/heap_trap.hpp"
 
 int main() {

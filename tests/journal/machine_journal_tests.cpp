@@ -15,9 +15,9 @@
 #include <fcntl.h>
 #include <unistd.h>
 
-#include "firmware/journal/journal_drain.hpp"
-#include "firmware/journal/journal_reader.hpp"
-#include "firmware/journal/journal_writer.hpp"
+#include "firmware/services/journal/journal_drain.hpp"
+#include "firmware/services/journal/journal_reader.hpp"
+#include "firmware/services/journal/journal_writer.hpp"
 #include "tests/fakes/fake_journal_storage.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

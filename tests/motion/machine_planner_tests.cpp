@@ -8,12 +8,12 @@
 #include <cstdlib>
 #include <vector>
 
-#include "firmware/motion/machine_frames.hpp"
-#include "firmware/motion/machine_planner.hpp"
-#include "firmware/motion/speed_limit.hpp"
-#include "firmware/stencil/sweep.hpp"
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
+#include "firmware/core/motion/machine_planner.hpp"
+#include "firmware/core/motion/speed_limit.hpp"
+#include "firmware/core/stencil/sweep.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/gouge_oracle.hpp"
 #include "tests/support/sample_tables.hpp"
 

@@ -6,10 +6,10 @@
 #include <new>
 #include <random>
 
-#include "firmware/stencil/contact_query.hpp"
-#include "firmware/stencil/haptic_force.hpp"
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "tests/support/heap_trap.hpp"
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/stencil/contact_query.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "toolchain/tablegen/tool_option.hpp"
 

@@ -6,8 +6,8 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "tests/support/gouge_oracle.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"

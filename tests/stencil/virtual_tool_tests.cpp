@@ -7,10 +7,10 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/stencil/haptic_force.hpp"
-#include "firmware/stencil/sweep.hpp"
-#include "firmware/stencil/virtual_tool.hpp"
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/stencil/sweep.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "tests/support/gouge_oracle.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"

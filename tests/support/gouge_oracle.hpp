@@ -5,7 +5,7 @@
 
 #include <Eigen/Core>
 
-#include "firmware/tables/part_tables.hpp"
+#include "firmware/core/tables/part_tables.hpp"
 #include "sim/mill/triangle_distance.hpp"
 
 namespace stencil::test {

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "firmware/geometry/tool_spec.hpp"
+#include "firmware/core/geometry/tool_spec.hpp"
 
 namespace stencil::test {
 

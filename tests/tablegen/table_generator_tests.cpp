@@ -2,7 +2,7 @@
 #include <cstring>
 #include <string>
 
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"

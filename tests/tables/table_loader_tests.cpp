@@ -5,9 +5,9 @@
 #include <random>
 #include <string>
 
-#include "firmware/geometry/tool_bsp_builder.hpp"
-#include "firmware/tables/table_loader.hpp"
-#include "firmware/tables/tool_section.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/tables/table_loader.hpp"
+#include "firmware/core/tables/tool_section.hpp"
 #include "tests/support/sample_tables.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.

@@ -6,16 +6,16 @@
 #include <fstream>
 #include <map>
 
-#include "firmware/journal/journal_bytes.hpp"
-#include "firmware/journal/journal_format.hpp"
-#include "firmware/journal/journal_reader.hpp"
+#include "firmware/services/journal/journal_bytes.hpp"
+#include "firmware/services/journal/journal_format.hpp"
+#include "firmware/services/journal/journal_reader.hpp"
 
 namespace stencil::same_behaviour {
 namespace {
 
 using journal::RecordType;
 
-// Where the start time sits in a payload (firmware/journal/journal_format.hpp): after the tables'
+// Where the start time sits in a payload (firmware/services/journal/journal_format.hpp): after the tables'
 // CRC-32 and triangle count in a Start record, after the segment in a Resume record. Checked
 // against the reader's own reading of the time below, so a changed layout is an error, not a
 // mask over the wrong bytes.

@@ -8,7 +8,7 @@
 #include <numeric>
 #include <thread>
 
-#include "firmware/geometry/kdop14.hpp"
+#include "firmware/core/geometry/kdop14.hpp"
 
 namespace stencil::tablegen {
 namespace {

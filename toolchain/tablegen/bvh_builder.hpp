@@ -4,7 +4,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "firmware/tables/table_format.hpp"
+#include "firmware/core/tables/table_format.hpp"
 
 namespace stencil::tablegen {
 

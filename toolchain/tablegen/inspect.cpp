@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/table_writer.hpp"
 

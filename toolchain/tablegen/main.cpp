@@ -11,7 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "firmware/tables/table_format.hpp"
+#include "firmware/core/tables/table_format.hpp"
 #include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/inspect.hpp"

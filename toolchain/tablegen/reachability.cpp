@@ -8,8 +8,8 @@
 #include <iterator>
 #include <thread>
 
-#include "firmware/geometry/kdop14.hpp"
-#include "firmware/geometry/upright_tool.hpp"
+#include "firmware/core/geometry/kdop14.hpp"
+#include "firmware/core/geometry/upright_tool.hpp"
 
 namespace stencil::tablegen {
 namespace {

@@ -8,8 +8,8 @@
 #include <nettle/sha2.h>
 
 #include "board/sherline_suzuki/rig_constants.hpp"
-#include "firmware/geometry/tool_bsp_builder.hpp"
-#include "firmware/tables/tool_section.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/tables/tool_section.hpp"
 #include "toolchain/tablegen/bvh_builder.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/point_cloud.hpp"

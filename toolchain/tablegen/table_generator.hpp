@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "firmware/geometry/tool_spec.hpp"
+#include "firmware/core/geometry/tool_spec.hpp"
 #include "toolchain/tablegen/part_mesh.hpp"
 #include "toolchain/tablegen/table_writer.hpp"
 

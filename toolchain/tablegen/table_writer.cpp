@@ -8,8 +8,8 @@
 #include <sstream>
 
 
-#include "firmware/tables/table_loader.hpp"
-#include "firmware/tables/tool_section.hpp"
+#include "firmware/core/tables/table_loader.hpp"
+#include "firmware/core/tables/tool_section.hpp"
 #include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "firmware/geometry/tool_bsp.hpp"
-#include "firmware/tables/table_format.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/tables/table_format.hpp"
 
 namespace stencil::tablegen {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "firmware/geometry/tool_spec.hpp"
+#include "firmware/core/geometry/tool_spec.hpp"
 
 namespace stencil::tablegen {
 

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <memory>
 
-#include "firmware/tables/table_loader.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 #include "sim/mill/machined_part.hpp"
 #include "sim/mill/stock_zmap.hpp"
 #include "tests/support/sample_tables.hpp"

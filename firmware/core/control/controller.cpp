@@ -1,0 +1,420 @@
+// The cycle: commands -> read -> engine -> write -> publish, and the latched safe state.
+#include "firmware/core/control/controller.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace stencil::control {
+namespace {
+
+constexpr double kNsPerS = 1e9;
+
+Eigen::Vector3d position_of(const hal::HapticSample& sample) {
+  return {sample.position_mm[0], sample.position_mm[1], sample.position_mm[2]};
+}
+
+void copy3(const Eigen::Vector3d& from, double (&to)[3]) {
+  to[0] = from.x();
+  to[1] = from.y();
+  to[2] = from.z();
+}
+
+}  // namespace
+
+Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device, const CycleRings& rings,
+                       const ControllerConfig& config)
+    : part_(part), device_(device), rings_(rings), config_(config), tool_(part, config.home_tip_mm) {
+  ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
+  tool_.limit_speed(config.max_axis_move_mm, config.max_total_move_mm);
+  last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
+  board_force_limit_n_ = config.haptic.max_force_n;
+  board_axis_move_mm_ = config.max_axis_move_mm;
+  board_total_move_mm_ = config.max_total_move_mm;
+  waiting_for_hand_ = config.start_held;
+}
+
+ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
+  if (!std::isfinite(value) || value <= 0.0) {
+    return ParameterOutcome::Refused;
+  }
+  switch (kind) {
+    case CommandKind::SetCoupling: {
+      const double applied =
+          std::clamp(value, config_.min_coupling_n_per_device_mm, config_.max_coupling_n_per_device_mm);
+      config_.haptic.coupling_n_per_device_mm = applied;
+      return applied == value ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetForceLimit: {
+      // Whatever it is sent, never above the board's limit.
+      config_.haptic.max_force_n = std::min(value, board_force_limit_n_);
+      return value <= board_force_limit_n_ ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetSpeedLimit: {
+      const double per_step_mm = value * config_.period_s;
+      config_.max_axis_move_mm = std::min(per_step_mm, board_axis_move_mm_);
+      config_.max_total_move_mm = std::min(per_step_mm, board_total_move_mm_);
+      tool_.limit_speed(config_.max_axis_move_mm, config_.max_total_move_mm);
+      return per_step_mm <= board_axis_move_mm_ && per_step_mm <= board_total_move_mm_ ? ParameterOutcome::Applied
+                                                                                        : ParameterOutcome::Clamped;
+    }
+    default:
+      return ParameterOutcome::Refused;
+  }
+}
+
+void Controller::write_zero_force() {
+  last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, static_cast<std::uint32_t>(cycle_), false};
+  static_cast<void>(device_.write_command(last_command_));
+}
+
+void Controller::enter_safe_state(SafeReason reason) {
+  if (safe_reason_ != SafeReason::None) {
+    return;  // latched: the first reason stays
+  }
+  safe_reason_ = reason;
+  ++counters_.safe_state_entries;
+  write_zero_force();  // at once, whatever else this cycle still does
+}
+
+ResetOutcome Controller::hand_held_near_tool(hal::MonotonicNs now_ns) const {
+  if (static_cast<double>(now_ns - still_since_ns_) < config_.still_time_s * kNsPerS) {
+    return ResetOutcome::DeviceNotStill;
+  }
+  const Eigen::Vector3d tool_on_device = motion::world_to_device(config_.frames, tool_.tip_mm());
+  if ((position_of(sample_) - tool_on_device).norm() > config_.reset_distance_mm) {
+    return ResetOutcome::DeviceFarFromTool;
+  }
+  return ResetOutcome::Accepted;
+}
+
+ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
+  if (safe_reason_ == SafeReason::None) {
+    return ResetOutcome::NotInSafeState;
+  }
+  // A link that latched a fault is cleared only once it is connected again.
+  if (device_.latched_fault() != hal::HapticFault::None && device_.link_state() == hal::HapticLinkState::Connected) {
+    device_.clear_fault();
+  }
+  if (!have_sample_ || cycles_since_fresh_ > config_.stale_periods ||
+      device_.latched_fault() != hal::HapticFault::None) {
+    return ResetOutcome::DeviceNotReady;
+  }
+  const ResetOutcome hand = hand_held_near_tool(now_ns);
+  if (hand != ResetOutcome::Accepted) {
+    return hand;
+  }
+  safe_reason_ = SafeReason::None;
+  ramp_start_ns_ = now_ns;
+  ramping_ = true;
+  consecutive_overruns_ = 0;
+  backlog_percent_ = 0.0;  // the machine side stopped with the safe state: its last backlog says nothing now
+  return ResetOutcome::Accepted;
+}
+
+void Controller::handle_commands(hal::MonotonicNs now_ns) {
+  // Bounded by the ring's capacity: a command pushed while draining waits for the next cycle.
+  for (std::size_t i = 0; i < CommandRing::capacity(); ++i) {
+    Command command{};
+    if (!rings_.commands.pop(command)) {
+      break;
+    }
+    switch (command.kind) {
+      case CommandKind::Stop:
+        enter_safe_state(SafeReason::Stopped);
+        break;
+      case CommandKind::JournalFailed:
+        enter_safe_state(SafeReason::JournalFailed);
+        break;
+      case CommandKind::Reset:
+        last_reset_ = try_reset(now_ns);
+        ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
+        break;
+      case CommandKind::SetCoupling:
+      case CommandKind::SetForceLimit:
+      case CommandKind::SetSpeedLimit:
+        last_parameter_ = command.kind;
+        last_parameter_outcome_ = set_parameter(command.kind, command.value);
+        ++parameter_requests_;
+        break;
+    }
+  }
+  for (std::size_t i = 0; i < MachineEventRing::capacity(); ++i) {
+    MachineEvent event{};
+    if (!rings_.machine_events.pop(event)) {
+      break;
+    }
+    if (event.kind == MachineEventKind::Fault) {
+      enter_safe_state(SafeReason::MachineFault);
+    } else if (event.kind == MachineEventKind::JournalFailed) {
+      enter_safe_state(SafeReason::JournalFailed);
+    } else if (event.kind == MachineEventKind::Backlog) {
+      backlog_percent_ = event.backlog_percent;
+    }
+  }
+}
+
+void Controller::recall_touched(const Eigen::Vector3d& tip_mm) {
+  static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip_mm, Eigen::Vector3d::UnitZ()},
+                                         config_.contact_tolerance_mm, touched_));
+}
+
+bool Controller::read_device(hal::MonotonicNs now_ns) {
+  hal::HapticSample sample{};
+  const hal::ReadResult read = device_.read_sample(now_ns, sample);
+  read_ = read;
+  if (read.status == hal::ReadStatus::Fresh) {
+    read_sample_ = sample;  // the journal keeps what the device said, even if refused below
+  }
+  fresh_ = false;
+  switch (read.status) {
+    case hal::ReadStatus::Fresh:
+      break;
+    case hal::ReadStatus::Stale:
+      ++counters_.stale_reads;
+      break;
+    case hal::ReadStatus::Rejected:
+      ++counters_.rejected_samples;
+      if (read.reason == hal::HapticFault::SampleOutOfRange) {
+        enter_safe_state(SafeReason::PoseOutOfWorkspace);
+        return false;
+      }
+      if (read.reason == hal::HapticFault::SampleNotFinite) {
+        enter_safe_state(SafeReason::PoseNotFinite);
+        return false;
+      }
+      break;
+    case hal::ReadStatus::Fault:
+      enter_safe_state(SafeReason::DeviceFault);
+      return false;
+  }
+  if (read.status != hal::ReadStatus::Fresh) {
+    ++cycles_since_fresh_;
+    if (cycles_since_fresh_ > config_.stale_periods) {
+      enter_safe_state(SafeReason::DeviceStale);
+    }
+    return have_sample_ && cycles_since_fresh_ <= config_.stale_periods;
+  }
+  if ((sample.status_bits & hal::haptic_status::kDeviceFault) != 0U) {
+    enter_safe_state(SafeReason::DeviceFault);  // the device's own fault: amplifier, encoder
+    return false;
+  }
+  const Eigen::Vector3d position = position_of(sample);
+  if (!position.allFinite() || !std::isfinite(sample.angles_rad[0]) || !std::isfinite(sample.angles_rad[1])) {
+    enter_safe_state(SafeReason::PoseNotFinite);
+    return false;
+  }
+  if ((position.array() < config_.device_low_mm.array()).any() ||
+      (position.array() > config_.device_high_mm.array()).any()) {
+    enter_safe_state(SafeReason::PoseOutOfWorkspace);
+    return false;
+  }
+  if (have_sample_) {
+    // The farthest a hand can move the handle since the last accepted sample (at least a period's
+    // worth, so a sample that was late by a cycle is not a jump).
+    const double seconds = static_cast<double>(now_ns - sample_time_ns_) / kNsPerS;
+    const double moved = (position - position_of(sample_)).norm();
+    if (moved > config_.max_device_speed_mm_per_s * std::max(seconds, 1e-3)) {
+      enter_safe_state(SafeReason::PoseJump);
+      return false;
+    }
+    if (seconds > 0.0 && moved > config_.still_speed_mm_per_s * seconds) {
+      still_since_ns_ = now_ns;
+    }
+  } else {
+    still_since_ns_ = now_ns;
+  }
+  sample_ = sample;
+  sample_time_ns_ = now_ns;
+  have_sample_ = true;
+  fresh_ = true;
+  cycles_since_fresh_ = 0;
+  ++counters_.fresh_samples;
+  return true;
+}
+
+CycleStatus Controller::step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+  begin_cycle(now_ns, deadline_ns);
+  if (!ready_) {
+    enter_safe_state(SafeReason::EngineFault);  // no contact tool (bad tables): never any force
+  }
+  handle_commands(now_ns);
+  const bool usable = read_device(now_ns);
+  release_held_start(now_ns, usable);
+  const EngineOutcome outcome = run_engine(usable);
+  write_force(now_ns, usable, outcome.output);
+  publish(now_ns, deadline_ns, outcome);
+  return safe_reason_ == SafeReason::None ? CycleStatus::Running : CycleStatus::SafeState;
+}
+
+void Controller::begin_cycle(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns) {
+  ++cycle_;
+  step_start_ns_ = now_ns;
+  statistics_.wakeup_latency.add(now_ns - deadline_ns);
+  const hal::MonotonicNs period_ns = next_deadline_ns_ - step_deadline_ns_;
+  if (next_deadline_ns_ != 0 && period_ns > 0 && deadline_ns > next_deadline_ns_) {
+    statistics_.missed_periods += static_cast<std::uint64_t>((deadline_ns - next_deadline_ns_) / period_ns);
+  }
+  step_deadline_ns_ = deadline_ns;
+  if (cycle_ == 1) {
+    ramp_start_ns_ = now_ns;
+    still_since_ns_ = now_ns;
+  }
+}
+
+void Controller::release_held_start(hal::MonotonicNs now_ns, bool usable) {
+  // A held start: nothing follows the hand until it is held still near the tool, as for a reset, so
+  // a handle left resting away from the tool cannot pull the tool (and the mill) the moment it starts.
+  if (waiting_for_hand_ && safe_reason_ == SafeReason::None && usable &&
+      hand_held_near_tool(now_ns) == ResetOutcome::Accepted) {
+    waiting_for_hand_ = false;
+    ramp_start_ns_ = now_ns;
+    ramping_ = true;
+  }
+}
+
+Controller::EngineOutcome Controller::run_engine(bool usable) {
+  // The device's tip in the world, the contact there, the virtual tool towards it.
+  EngineOutcome outcome{position_of(sample_),
+                        Eigen::Vector3d::Zero(),
+                        {engine::QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()},
+                        {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), false, false},
+                        engine::RemediationStatus::Stuck};
+  outcome.desired_tip_mm = motion::device_to_world(config_.frames, outcome.device_mm);
+  if (safe_reason_ != SafeReason::None || !usable || waiting_for_hand_) {
+    return outcome;
+  }
+  // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
+  // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
+  const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
+  if (std::isfinite(config_.max_axis_move_mm) && std::isfinite(config_.max_total_move_mm)) {
+    tool_.limit_speed(backlog_scale * config_.max_axis_move_mm, backlog_scale * config_.max_total_move_mm);
+  }
+  const Eigen::Vector3d& desired = outcome.desired_tip_mm;
+  outcome.contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
+  const engine::RemediationResult moved = tool_.step(desired, outcome.contact, config_.contact);
+  outcome.remediation = moved.status;
+  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic);
+  if (outcome.contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
+      outcome.output.fault) {
+    enter_safe_state(SafeReason::EngineFault);
+  } else {
+    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
+                                           touched_));
+    max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
+  }
+  return outcome;
+}
+
+void Controller::write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output) {
+  // Zero in the safe state (already written when it was entered) and while a held start waits for
+  // the hand, ramped in after a reset or the start.
+  if (safe_reason_ != SafeReason::None || waiting_for_hand_) {
+    write_zero_force();  // every cycle: it also beats the host heartbeat the device watches
+    return;
+  }
+  double scale = 1.0;
+  if (ramping_) {
+    const double elapsed = static_cast<double>(now_ns - ramp_start_ns_) / kNsPerS;
+    scale = config_.ramp_time_s > 0.0 ? std::clamp(elapsed / config_.ramp_time_s, 0.0, 1.0) : 1.0;
+    ramping_ = scale < 1.0;
+  }
+  const Eigen::Vector3d force = usable ? Eigen::Vector3d(scale * output.force_n) : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d torque = usable ? Eigen::Vector3d(scale * output.torque_nmm) : Eigen::Vector3d::Zero();
+  last_command_ = {{force.x(), force.y(), force.z()},
+                   {torque.x(), torque.y()},
+                   static_cast<std::uint32_t>(cycle_),
+                   usable};
+  max_force_n_ = std::max(max_force_n_, force.norm());
+  if (device_.write_command(last_command_).status == hal::WriteStatus::Fault) {
+    enter_safe_state(SafeReason::DeviceFault);
+  }
+}
+
+void Controller::publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, const EngineOutcome& outcome) {
+  if (!rings_.journal.push(build_journal_record(now_ns))) {
+    enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
+  }
+  // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
+  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
+  copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
+  if (!rings_.machine.push(handoff)) {
+    enter_safe_state(SafeReason::MachineFault);
+  }
+  // Last, so that it shows the safe state the journal and the handoff may have just entered.
+  if (!rings_.telemetry.push(build_telemetry(now_ns, deadline_ns, outcome))) {
+    ++counters_.telemetry_dropped;
+  }
+}
+
+JournalRecord Controller::build_journal_record(hal::MonotonicNs now_ns) const {
+  // The read as the device gave it (a replay feeds it back to the cycle), else the last sample used.
+  const hal::HapticSample& recorded = read_.status == hal::ReadStatus::Fresh ? read_sample_ : sample_;
+  JournalRecord record{};
+  record.cycle = cycle_;
+  record.time_ns = now_ns;
+  copy3(position_of(recorded), record.device_mm);
+  record.angles_rad[0] = recorded.angles_rad[0];
+  record.angles_rad[1] = recorded.angles_rad[1];
+  record.sample_counter = recorded.sample_counter;
+  record.status_bits = static_cast<std::uint16_t>(recorded.status_bits & 0xFFFFU);
+  record.read_status = read_.status;
+  record.read_reason = read_.reason;
+  record.fresh = fresh_;
+  copy3(tool_.tip_mm(), record.virtual_tip_mm);
+  record.safe_reason = safe_reason_;  // as it stands before the machine handoff
+  record.touched_triangles = static_cast<std::uint32_t>(touched_.count());
+  for (int i = 0; i < 3; ++i) {
+    record.force_n[i] = static_cast<float>(last_command_.force_n[i]);
+  }
+  return record;
+}
+
+Telemetry Controller::build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
+                                      const EngineOutcome& outcome) const {
+  Telemetry telemetry{};
+  telemetry.cycle = cycle_;
+  telemetry.time_ns = now_ns;
+  copy3(outcome.device_mm, telemetry.device_mm);
+  copy3(outcome.desired_tip_mm, telemetry.desired_tip_mm);
+  copy3(tool_.tip_mm(), telemetry.virtual_tip_mm);
+  for (int i = 0; i < 3; ++i) {
+    telemetry.force_n[i] = last_command_.force_n[i];
+  }
+  telemetry.max_depth_mm = outcome.contact.max_depth_mm;
+  telemetry.touched_triangles = static_cast<std::uint32_t>(touched_.count());
+  telemetry.remediation = outcome.remediation;
+  telemetry.safe_reason = safe_reason_;
+  telemetry.reset_requests = static_cast<std::uint32_t>(counters_.resets_accepted + counters_.resets_refused);
+  telemetry.last_reset = last_reset_;
+  telemetry.device_still_s = static_cast<double>(now_ns - still_since_ns_) / kNsPerS;
+  telemetry.device_to_tool_mm = (outcome.device_mm - motion::world_to_device(config_.frames, tool_.tip_mm())).norm();
+  telemetry.wakeup_ns = now_ns - deadline_ns;
+  telemetry.last_compute_ns = last_compute_ns_;
+  telemetry.coupling_n_per_device_mm = config_.haptic.coupling_n_per_device_mm;
+  telemetry.force_limit_n = config_.haptic.max_force_n;
+  telemetry.speed_limit_mm_per_s = config_.max_axis_move_mm / config_.period_s;
+  telemetry.parameter_requests = parameter_requests_;
+  telemetry.last_parameter = last_parameter_;
+  telemetry.last_parameter_outcome = last_parameter_outcome_;
+  return telemetry;
+}
+
+void Controller::finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns) {
+  statistics_.compute.add(end_ns - step_start_ns_);
+  last_compute_ns_ = end_ns - step_start_ns_;
+  next_deadline_ns_ = next_deadline_ns;
+  ++statistics_.cycles;
+  if (!config_.count_overruns) {
+    return;
+  }
+  if (end_ns > next_deadline_ns) {
+    ++statistics_.overruns;
+    if (++consecutive_overruns_ > config_.overrun_limit) {
+      enter_safe_state(SafeReason::OverrunStorm);
+    }
+  } else {
+    consecutive_overruns_ = 0;
+  }
+}
+
+}  // namespace stencil::control

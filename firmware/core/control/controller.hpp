@@ -1,0 +1,190 @@
+// Controller: the 1 kHz cycle. One step() per period: commands in, read the device sample and check
+// it, the engine (map it to the world, query and remediate), write the force, publish (the journal
+// record, the virtual tool to the machine side, telemetry); and the safe state, latched, with its
+// reset rule.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+#include <Eigen/Core>
+
+#include "firmware/core/control/cycle_messages.hpp"
+#include "firmware/core/control/loop_statistics.hpp"
+#include "firmware/core/control/safe_state.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
+#include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/stencil/triangle_set.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "firmware/core/tables/part_tables.hpp"
+#include "hal/haptic_device.hpp"
+
+namespace stencil::control {
+
+// What a board decides about the cycle (the rig's numbers by default).
+struct ControllerConfig {
+  motion::MachineFrames frames;           // device -> world
+  engine::ContactParameters contact;
+  engine::HapticLimits haptic;
+  Eigen::Vector3d device_low_mm;          // a sample outside [low, high] (device mm) is out of the reach
+  Eigen::Vector3d device_high_mm;
+  Eigen::Vector3d home_tip_mm;            // world: where the virtual tool starts (the machine's home)
+  double contact_tolerance_mm = 0.005;    // a point this near the virtual tool is touched
+  // The most the virtual tool may move in one period, per axis and all axes together (|dx|+|dy|+|dz|),
+  // so the mill can follow (motion::MachineSpeed times the period); unlimited by default.
+  double max_axis_move_mm = std::numeric_limits<double>::infinity();
+  double max_total_move_mm = std::numeric_limits<double>::infinity();
+  int stale_periods = 5;                  // more periods than this without a fresh sample: safe state
+  double max_device_speed_mm_per_s = 3000.0;  // faster than a hand can move the handle: a jump
+  int overrun_limit = 3;                  // more consecutive overruns than this: safe state
+  bool count_overruns = true;             // false on a virtual clock, where lateness means nothing
+  double still_speed_mm_per_s = 2.0;      // a reset needs the device slower than this ...
+  double still_time_s = 0.5;              // ... for this long ...
+  double reset_distance_mm = 5.0;         // ... and this near the virtual tool (device mm)
+  double ramp_time_s = 0.5;               // force comes back over this long after a reset
+  // The rig: the cycle starts held (zero force, the virtual tool at home) until the hand is held as
+  // for a reset (still, near the tool); the simulation's scripted hand starts at once.
+  bool start_held = false;
+  double period_s = 1e-3;                 // the cycle's period: a speed limit in mm/s is this much per step
+  // The operator may set the coupling within [min, max] (N per device mm); the force limit and the
+  // speed limit only ever below the board's (haptic.max_force_n and the move limits above).
+  double min_coupling_n_per_device_mm = 0.05;
+  double max_coupling_n_per_device_mm = 2.0;
+};
+
+enum class CycleStatus : std::uint8_t {
+  Running,    // force is being rendered
+  SafeState,  // force zero, machine told to stop; see safe_reason()
+};
+
+// Counters of what the cycle refused or dropped, never reset.
+struct CycleCounters {
+  std::uint64_t fresh_samples = 0;
+  std::uint64_t stale_reads = 0;
+  std::uint64_t rejected_samples = 0;  // refused by the backend (range, torn, bad frames)
+  std::uint64_t telemetry_dropped = 0;
+  std::uint64_t safe_state_entries = 0;
+  std::uint64_t resets_accepted = 0;
+  std::uint64_t resets_refused = 0;
+};
+
+class Controller {
+ public:
+  // Init time: builds the grown tool for the touched set. `part`, `device` and the rings must outlive
+  // the controller. The controller is large (the touched set): give it static storage.
+  Controller(const tables::PartTables& part, hal::HapticDevice& device, const CycleRings& rings,
+             const ControllerConfig& config);
+  Controller(const Controller&) = delete;
+  Controller& operator=(const Controller&) = delete;
+
+  // False when the grown contact tool could not be built (bad tool in the tables): do not run.
+  [[nodiscard]] bool ready() const { return ready_; }
+  // A held start still waiting for the hand (ControllerConfig::start_held).
+  [[nodiscard]] bool waiting_for_hand() const { return waiting_for_hand_; }
+
+  // One cycle, started at now_ns for the period that was due at deadline_ns. Real-time safe: no
+  // allocation, lock, throw or blocking call; bounded work (the engine's bounds, the command ring's
+  // capacity).
+  [[nodiscard]] CycleStatus step(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns);
+
+  // After step(): when it ended and when the next period is due, for the statistics and the
+  // overrun watchdog (which may enter the safe state, writing zero force at once). Real-time safe.
+  void finish(hal::MonotonicNs end_ns, hal::MonotonicNs next_deadline_ns);
+
+  // Init time, before the first step(), never from the cycle: a resumed job's touched set, rebuilt
+  // from the virtual tool's tips its journal recorded, in order (the cycle marks the same way).
+  void recall_touched(const Eigen::Vector3d& tip_mm);
+
+  // Whether lateness counts (ControllerConfig::count_overruns), switched by the cycle's own thread:
+  // the simulation turns it on to inject a stalled host on its virtual clock.
+  void set_count_overruns(bool on) { config_.count_overruns = on; }
+
+  [[nodiscard]] SafeReason safe_reason() const { return safe_reason_; }
+  [[nodiscard]] ResetOutcome last_reset() const { return last_reset_; }
+  [[nodiscard]] const LoopStatistics& statistics() const { return statistics_; }
+  [[nodiscard]] const CycleCounters& counters() const { return counters_; }
+  [[nodiscard]] const engine::TriangleSet& touched() const { return touched_; }
+  [[nodiscard]] Eigen::Vector3d virtual_tip_mm() const { return tool_.tip_mm(); }
+  [[nodiscard]] const hal::HapticCommand& last_command() const { return last_command_; }
+  [[nodiscard]] double max_force_n() const { return max_force_n_; }
+  [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
+
+ private:
+  void enter_safe_state(SafeReason reason);
+  void write_zero_force();
+  void handle_commands(hal::MonotonicNs now_ns);
+  [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);
+  // The reset rule's hand: still long enough, near enough the virtual tool (Accepted when both).
+  [[nodiscard]] ResetOutcome hand_held_near_tool(hal::MonotonicNs now_ns) const;
+  [[nodiscard]] ParameterOutcome set_parameter(CommandKind kind, double value);
+  // What the engine made of this cycle's sample, for the force and the telemetry.
+  struct EngineOutcome {
+    Eigen::Vector3d device_mm;       // the sample in use, device space
+    Eigen::Vector3d desired_tip_mm;  // it in the world: where the hand wants the tool
+    engine::ContactResult contact;   // at the desired pose (none when the engine did not run)
+    engine::HapticOutput output;     // unramped force and torque (zero when the engine did not run)
+    engine::RemediationStatus remediation;
+  };
+
+  // step()'s parts, in its order. Each real-time safe, as step() is.
+  // The cycle's count, its wake-up latency and the periods it missed.
+  void begin_cycle(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns);
+  // Reads the device and checks the sample; false when the cycle must not render force.
+  [[nodiscard]] bool read_device(hal::MonotonicNs now_ns);
+  // Ends a held start once the hand is held still near the tool.
+  void release_held_start(hal::MonotonicNs now_ns, bool usable);
+  // Contact, remediation and force at the sample, when the cycle renders force (else all zero).
+  [[nodiscard]] EngineOutcome run_engine(bool usable);
+  // The force to the device: ramped in, or zero in the safe state and a held start.
+  void write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output);
+  // The journal record, the machine handoff and the telemetry, in that order.
+  void publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, const EngineOutcome& outcome);
+  [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
+  [[nodiscard]] Telemetry build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
+                                          const EngineOutcome& outcome) const;
+
+  const tables::PartTables& part_;
+  hal::HapticDevice& device_;
+  CycleRings rings_;
+  ControllerConfig config_;
+  engine::VirtualTool tool_;
+  geometry::ToolBsp contact_tool_{};
+  engine::TriangleSet touched_;
+  bool ready_ = false;
+
+  std::uint64_t cycle_ = 0;
+  SafeReason safe_reason_ = SafeReason::None;
+  ResetOutcome last_reset_ = ResetOutcome::NotInSafeState;
+  hal::HapticSample sample_{};             // the last accepted sample
+  hal::ReadResult read_{hal::ReadStatus::Stale, hal::HapticFault::None};  // this cycle's read, for the journal
+  hal::HapticSample read_sample_{};        // what it gave when Fresh, accepted here or not
+  bool have_sample_ = false;
+  bool fresh_ = false;                     // this cycle's read gave a new sample
+  hal::MonotonicNs sample_time_ns_ = 0;    // when it was read
+  int cycles_since_fresh_ = 0;
+  hal::MonotonicNs still_since_ns_ = 0;    // the device has been slower than the still speed since
+  hal::MonotonicNs ramp_start_ns_ = 0;     // force ramps in from here after a reset (or the start)
+  bool ramping_ = true;
+  bool waiting_for_hand_ = false;  // a held start (config.start_held) until the hand is held near the tool
+  int consecutive_overruns_ = 0;
+  double backlog_percent_ = 0.0;           // the mill's path still to follow, from its last update
+  hal::MonotonicNs step_start_ns_ = 0;
+  hal::MonotonicNs step_deadline_ns_ = 0;
+  hal::MonotonicNs next_deadline_ns_ = 0;  // from the last finish(): when the next step was due
+  hal::MonotonicNs last_compute_ns_ = 0;   // the last finish()'s step time
+  // The board's limits, from the config at start-up: what the operator's parameters never exceed.
+  double board_force_limit_n_ = 0.0;
+  double board_axis_move_mm_ = 0.0;
+  double board_total_move_mm_ = 0.0;
+  std::uint32_t parameter_requests_ = 0;
+  CommandKind last_parameter_ = CommandKind::SetCoupling;
+  ParameterOutcome last_parameter_outcome_ = ParameterOutcome::None;
+  hal::HapticCommand last_command_{};
+  double max_force_n_ = 0.0;
+  double max_offset_mm_ = 0.0;
+  LoopStatistics statistics_;
+  CycleCounters counters_;
+};
+
+}  // namespace stencil::control

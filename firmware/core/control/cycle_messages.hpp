@@ -1,0 +1,196 @@
+// The plain-data records the cycle exchanges with the threads around it, each through its own
+// SpscRing: commands in, and out the machine handoff, telemetry and the journal.
+#pragma once
+
+#include <cstdint>
+
+#include "firmware/core/control/safe_state.hpp"
+#include "firmware/core/control/spsc_ring.hpp"
+#include "firmware/core/stencil/virtual_tool.hpp"
+#include "hal/haptic_device.hpp"
+#include "hal/machine_link.hpp"
+
+namespace stencil::control {
+
+enum class CommandKind : std::uint8_t {
+  Reset,  // leave the safe state (accepted only while the device is held still near the virtual tool)
+  Stop,   // enter it (SIGINT/SIGTERM, the terminal, the display)
+  JournalFailed,  // enter it: the journal writer could not write the record (the cut must stop)
+  // The operator's parameters (the display), taken at the cycle's boundary; `value` in the unit named.
+  // The cycle clamps each to the board's own limit whatever it is sent (see ParameterOutcome).
+  SetCoupling,    // N per device mm: the pull of the device towards the virtual tool
+  SetForceLimit,  // N: never above the board's limit (ControllerConfig::haptic at start-up)
+  SetSpeedLimit,  // world mm/s of the virtual tool: never above the mill's (the config's move limits)
+};
+
+struct Command {
+  CommandKind kind;
+  double value = 0.0;  // the Set* commands' new value
+};
+
+// The operator's parameter a Set* command sets, by the name the display uses in its requests and
+// its state feed ("coupling", "force_limit", "speed_limit"); "none" for the other commands.
+[[nodiscard]] constexpr const char* parameter_name(CommandKind kind) {
+  switch (kind) {
+    case CommandKind::SetCoupling:
+      return "coupling";
+    case CommandKind::SetForceLimit:
+      return "force_limit";
+    case CommandKind::SetSpeedLimit:
+      return "speed_limit";
+    case CommandKind::Reset:
+    case CommandKind::Stop:
+    case CommandKind::JournalFailed:
+      break;
+  }
+  return "none";
+}
+
+// What the cycle made of the newest Set* command.
+enum class ParameterOutcome : std::uint8_t {
+  None,     // none taken yet
+  Applied,  // as asked
+  Clamped,  // above the board's limit (or below the least): the limit applies instead
+  Refused,  // not a finite positive number: nothing changed
+};
+
+[[nodiscard]] constexpr const char* parameter_outcome_name(ParameterOutcome outcome) {
+  switch (outcome) {
+    case ParameterOutcome::None:
+      return "none";
+    case ParameterOutcome::Applied:
+      return "applied";
+    case ParameterOutcome::Clamped:
+      return "clamped";
+    case ParameterOutcome::Refused:
+      return "refused";
+  }
+  return "unknown";
+}
+
+// Why a reset was refused, or that it was taken.
+enum class ResetOutcome : std::uint8_t {
+  Accepted,
+  NotInSafeState,
+  DeviceNotStill,     // the device moved faster than the still speed in the still time
+  DeviceFarFromTool,  // the device is not near the virtual tool: force would jump
+  DeviceNotReady,     // no fresh sample, or the haptic link still latches a fault
+};
+
+// What a reset came to, for the operator ("accepted", "device_not_still", ...).
+[[nodiscard]] constexpr const char* reset_outcome_name(ResetOutcome outcome) {
+  switch (outcome) {
+    case ResetOutcome::Accepted:
+      return "accepted";
+    case ResetOutcome::NotInSafeState:
+      return "not_in_safe_state";
+    case ResetOutcome::DeviceNotStill:
+      return "device_not_still";
+    case ResetOutcome::DeviceFarFromTool:
+      return "device_far_from_tool";
+    case ResetOutcome::DeviceNotReady:
+      return "device_not_ready";
+  }
+  return "unknown";
+}
+
+// Every cycle, to the machine side: where the virtual tool is (world mm, always legal) and whether
+// the machine must stop.
+struct MachineHandoff {
+  std::uint64_t cycle;
+  double virtual_tip_mm[3];
+  bool safe_state;  // hold the feed, then switch the drivers off; move nothing until reset
+};
+
+// From the machine side, when something happens there.
+enum class MachineEventKind : std::uint8_t {
+  Fault,    // the link latched a fault: the cycle enters the safe state
+  Stopped,  // the machine is stopped (after a safe state): for the record
+  JournalFailed,  // a target could not be recorded, so it was not sent: the cycle enters the safe state
+  Backlog,        // how much of the path the mill has still to follow (each update): the cycle slows the tool
+};
+
+struct MachineEvent {
+  MachineEventKind kind;
+  hal::MachineFault fault = hal::MachineFault::None;  // Fault, JournalFailed: what the link had latched
+  bool stop_confirmed = false;                         // Stopped: the link confirmed spindle and drivers off
+  std::uint8_t backlog_percent = 0;                    // Backlog: how full the planner's path is, % of its capacity
+};
+
+// About 20 Hz is enough for people; the cycle pushes every cycle and a full ring drops (counted).
+struct Telemetry {
+  std::uint64_t cycle;
+  std::int64_t time_ns;
+  double device_mm[3];       // device space
+  double desired_tip_mm[3];  // world
+  double virtual_tip_mm[3];  // world
+  double force_n[3];         // as written to the device
+  double max_depth_mm;       // deepest penetration at the desired pose
+  std::uint32_t touched_triangles;
+  engine::RemediationStatus remediation;
+  SafeReason safe_reason;
+  std::uint32_t reset_requests;  // reset commands taken so far (accepted or refused)
+  ResetOutcome last_reset;       // what the newest of them came to
+  // For a reset control: how long the device has been held still, and how far it is from the
+  // virtual tool (device mm); the cycle's own reset rule decides, these let a display say why not.
+  double device_still_s;
+  double device_to_tool_mm;
+  // The loop's health: this cycle's wake-up latency and the previous cycle's compute time.
+  std::int64_t wakeup_ns;
+  std::int64_t last_compute_ns;
+  // The parameters in force, and what the newest Set* command came to.
+  double coupling_n_per_device_mm;
+  double force_limit_n;
+  double speed_limit_mm_per_s;   // infinity: unlimited
+  std::uint32_t parameter_requests;
+  CommandKind last_parameter;
+  ParameterOutcome last_parameter_outcome;
+};
+
+// Everything a replay needs and nothing is allowed to lose: the journal ring being full is a fault.
+struct JournalRecord {
+  std::uint64_t cycle;
+  std::int64_t time_ns;
+  double device_mm[3];
+  double angles_rad[2];
+  std::uint32_t sample_counter;
+  bool fresh;                // a new sample this cycle, accepted by the cycle
+  double virtual_tip_mm[3];
+  SafeReason safe_reason;    // as latched at the end of the cycle
+  std::uint32_t touched_triangles;  // the touched set's size after the cycle: progress, and a check on a rebuild
+  float force_n[3];          // as written to the device
+  // The cycle's read as the device gave it (device_mm, angles_rad, sample_counter and status_bits are
+  // its sample when read_status is Fresh, even if the cycle refused it; else the last sample used).
+  std::uint16_t status_bits;
+  hal::ReadStatus read_status;
+  hal::HapticFault read_reason;
+};
+
+// The rings around the cycle: capacities in the types. The machine side drains its ring at each
+// machine update (about 30 Hz), so it holds well over a machine update's worth of cycles.
+using CommandRing = SpscRing<Command, 16>;
+using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
+using MachineEventRing = SpscRing<MachineEvent, 16>;
+using TelemetryRing = SpscRing<Telemetry, 64>;
+using JournalRing = SpscRing<JournalRecord, 4096>;
+
+struct CycleRings {
+  CommandRing& commands;          // in: reset, stop
+  MachineEventRing& machine_events;  // in: the machine side's faults
+  MachineHandoffRing& machine;    // out: every cycle's virtual tool
+  TelemetryRing& telemetry;       // out: dropped and counted when full
+  JournalRing& journal;           // out: full is a fault
+};
+
+// The rings of one cycle, owned together: a board allocates one of these at start-up (they are
+// large: the journal ring alone holds seconds of records) and hands the cycle its rings().
+struct CycleRingStorage {
+  CommandRing commands;
+  MachineEventRing machine_events;
+  MachineHandoffRing machine;
+  TelemetryRing telemetry;
+  JournalRing journal;
+  [[nodiscard]] CycleRings rings() { return {commands, machine_events, machine, telemetry, journal}; }
+};
+
+}  // namespace stencil::control

@@ -1,0 +1,121 @@
+// The machine waypoint planner: turns the virtual tool's legal path into the mill's targets, one
+// per machine update, so that what the mill actually does (straight segments, one axis at a time
+// inside each) is legal too, within its speed, inside its travel, with backlash taken up.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "firmware/core/motion/machine_frames.hpp"
+#include "firmware/core/motion/speed_limit.hpp"
+#include "firmware/core/tables/part_tables.hpp"
+
+namespace stencil::motion {
+
+// Going back fewer steps than this on an axis is first tried as not going back at all (see
+// MachinePlanner::grid_target): the virtual tool trembles by micrometres against a wall, and each
+// reversal costs a backlash take-up. So a held axis may end up to this many steps (plus one of
+// rounding) from the virtual tool.
+inline constexpr double kReversalDeadbandSteps = 4.0;
+
+struct PlannerLimits {
+  MachineSpeed speed;
+  double update_period_s;                     // one machine update (1/30 s on the rig)
+  std::array<std::int32_t, 3> backlash_steps; // slack per axis, taken up on every reversal
+};
+
+// The order in which the mill moves its axes inside one update (the CY545 steps one axis at a
+// time): the machine link must execute the legs in this order, since only this staircase was
+// checked.
+using AxisOrder = std::array<std::uint8_t, 3>;
+
+enum class PlanStatus : std::uint8_t {
+  Moved,        // a new target: the tool moves
+  TakingUp,     // a new target that only takes up backlash (motors move, the tool does not)
+  AtGoal,       // nothing to do: the mill is where the virtual tool is
+  Waiting,      // two updates are already queued: nothing new until the link completes one
+  Blocked,      // no legal staircase to any point of the path within this update: holding
+  NotHomed,     // no target before homed()
+  Fault,        // bad numbers or damaged tables: stop the machine
+};
+
+struct PlanResult {
+  PlanStatus status;
+  MachineSteps motor_target;   // what to send: axis target plus backlash compensation
+  MachineSteps axis_target;    // where the tool will be, in steps
+  AxisOrder order;             // legs in this order
+  Eigen::Vector3d target_mm;   // axis_target in the world
+  double lag_mm;               // distance from the newest virtual tool to axis_target
+  std::int32_t motor_steps;    // steps of all axes in this update (take-up included)
+};
+
+enum class PathStatus : std::uint8_t {
+  Added,    // stored as the path's newest point
+  Ignored,  // on the same step as the newest point: nothing to store
+  Full,     // the mill is too far behind the virtual tool: a fault (the cycle's speed limit should
+            // make this impossible)
+  Invalid,  // not finite, or beyond the steps the CY545 can count
+};
+
+// Owned by the machine side: its own read-only view of the tables, its own engine scratch (each
+// legality query), never the touched set. Allocation-free after construction; plan() does at most
+// kMaxCandidates x 6 orders x 3 legs sweeps, each of a bounded number of sub-steps.
+class MachinePlanner {
+ public:
+  static constexpr std::size_t kPathCapacity = 4096;  // points at least a step apart: seconds of motion
+  static constexpr int kMaxQueuedUpdates = 2;
+  static constexpr int kMaxCandidates = 14;
+
+  MachinePlanner(const tables::PartTables& part, const MachineFrames& frames, const PlannerLimits& limits);
+
+  // The machine has been homed and stands at `at` (steps), its last motion on each axis in
+  // direction approach[i] (+1 or -1: where the slack is). The path restarts there; nothing queued.
+  void homed(const MachineSteps& at, const std::array<int, 3>& approach);
+
+  // The virtual tool's (legal) tip, as often as the cycle hands it over; stored when it is on
+  // another step than the newest stored point.
+  [[nodiscard]] PathStatus follow(const Eigen::Vector3d& virtual_tip_mm);
+
+  // One machine update. `completed`: how many earlier targets the link has finished since the last
+  // call. Returns the next target to queue, or why there is none.
+  [[nodiscard]] PlanResult plan(int completed);
+
+  [[nodiscard]] const MachineSteps& axis_steps() const { return axis_; }
+  [[nodiscard]] const MachineSteps& motor_steps() const { return motor_; }
+  [[nodiscard]] std::size_t path_size() const { return path_size_; }
+  [[nodiscard]] int queued() const { return queued_; }
+
+ private:
+  [[nodiscard]] const Eigen::Vector3d& path_at(std::size_t i) const;
+  void drop_path_before(std::size_t i);
+  [[nodiscard]] Eigen::Vector3d exact_steps(const Eigen::Vector3d& world_mm) const;
+  [[nodiscard]] Eigen::Vector3d current() const;
+  [[nodiscard]] bool clip_to_budget(const Eigen::Vector3d& goal, Eigen::Vector3d& clipped) const;
+  [[nodiscard]] bool grid_target(const Eigen::Vector3d& wanted, MachineSteps& target, AxisOrder& order) const;
+  [[nodiscard]] bool corner_target(const Eigen::Vector3d& exact, MachineSteps& target, AxisOrder& order) const;
+  [[nodiscard]] int legal_order(const MachineSteps& to, AxisOrder& order) const;
+  [[nodiscard]] PlanResult result(PlanStatus status) const;
+
+  const tables::PartTables& part_;
+  MachineFrames frames_;
+  PlannerLimits limits_;
+  double sweep_step_mm_;
+  std::int32_t axis_budget_;   // steps one axis may make in an update (its speed)
+  std::int32_t total_budget_;  // steps all axes together may make in an update (the step rate)
+  bool homed_ = false;
+  MachineSteps axis_{};                 // commanded tool position, steps
+  MachineSteps motor_{};                // commanded motor position, steps
+  std::array<int, 3> slack_side_{};     // +1: last moved +, the slack is behind; -1 the other way
+  std::array<std::int32_t, 3> take_up_left_{};  // steps of a reversal's take-up not yet commanded
+  std::array<int, 3> take_up_direction_{};
+  int queued_ = 0;
+  std::array<Eigen::Vector3d, kPathCapacity> path_;  // ring, oldest at path_head_
+  std::size_t path_head_ = 0;
+  std::size_t path_size_ = 0;
+  Eigen::Vector3d newest_mm_ = Eigen::Vector3d::Zero();
+};
+
+}  // namespace stencil::motion

@@ -1,0 +1,263 @@
+// The query: the tool's 14-DOP against the points' tree, then each nearby point through the tool BSP.
+#include "firmware/core/stencil/contact_query.hpp"
+
+#include <array>
+#include <cmath>
+
+#include <Eigen/Geometry>
+
+#include "firmware/core/geometry/kdop14.hpp"
+#include "firmware/core/geometry/meridian_box.hpp"
+#include "firmware/core/geometry/tool_bound.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/geometry/upright_tool.hpp"
+#include "firmware/core/stencil/leaf_contacts.hpp"
+
+namespace stencil::engine {
+namespace {
+
+enum class Walk : std::uint8_t { Finished, Stopped, BadTree };
+
+bool pose_is_usable(const ToolPose& pose) {
+  return pose.tip_mm.allFinite() && pose.axis.allFinite() && std::abs(pose.axis.squaredNorm() - 1.0) < 1e-9;
+}
+
+bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) {
+  for (std::size_t slab = 0; slab < geometry::kKdopSlabCount; ++slab) {
+    if (volume.min[slab] > node.dop_max[slab] || node.dop_min[slab] > volume.max[slab]) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// Walks the points' tree for the tool at `pose`. Leaves are culled by the tool's 14-DOP and, for
+// the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
+// end). For the upright tool each remaining leaf goes to visit_leaf as a whole, its points' depths
+// and escape directions computed lane-wise: from one region's surface when the leaf's box lies in
+// that region or just straddles its boundary (no walk of the tool tree per point), from the two
+// sides' regions when it straddles a partition plane, point by point through the tool tree when
+// it straddles other tests, skipped when the box is wholly outside. For any other axis each point
+// goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
+// on its surface. Either visitor stops the walk by returning false. Iterative, with a fixed stack
+// as deep as the loader allows trees to be.
+enum class Wanted : std::uint8_t {
+  Penetrating,  // only points deeper than the tolerance matter (force, legality)
+  InTool,       // points on the surface matter too (touched triangles)
+};
+
+template <typename VisitPoint, typename VisitLeaf>
+Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
+                         Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf) {
+  const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
+  const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
+  std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
+  std::size_t size = 0;
+  stack[size++] = 0;
+  LeafContacts leaf;
+  while (size > 0) {
+    const std::uint32_t index = stack[--size];
+    if (index >= part.node_count()) {
+      return Walk::BadTree;
+    }
+    const tables::BvhNode& node = part.nodes[index];
+    if (!overlaps_node(volume, node)) {
+      continue;
+    }
+    const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
+    const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
+    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
+      continue;
+    }
+    if (node.point_count > 0) {
+      if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
+          node.point_count > part.point_count() - node.first_point) {
+        return Walk::BadTree;  // a leaf the loader would have refused
+      }
+      if (upright) {
+        const geometry::BoxClassification cover =
+            geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+        if (cover.cover == geometry::BoxCover::Outside) {
+          continue;
+        }
+        // No point of the leaf can be deeper than the tolerance (half of it, so that the lanes'
+        // rounding cannot matter): only touching points, which only the touched set wants.
+        if (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
+            cover.deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm) {
+          continue;
+        }
+        load_leaf(part, node.first_point, node.point_count, pose.tip_mm, leaf);
+        bool finite = false;
+        switch (cover.cover) {
+          case geometry::BoxCover::Region:
+          case geometry::BoxCover::RegionOrOutside:
+            finite = region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
+            break;
+          case geometry::BoxCover::SplitAtZ:
+            finite = split_leaf_contacts(tool, cover, leaf);
+            break;
+          case geometry::BoxCover::Outside:  // skipped above
+          case geometry::BoxCover::Mixed:
+            finite = mixed_leaf_contacts(tool, leaf);
+            break;
+        }
+        if (!finite) {
+          return Walk::BadTree;
+        }
+        if (!visit_leaf(leaf)) {
+          return Walk::Stopped;
+        }
+        continue;
+      }
+      for (std::uint32_t i = node.first_point; i < node.first_point + node.point_count; ++i) {
+        const tables::PackedPoint& p = part.points[i];
+        const Eigen::Vector3d point(p.x_mm, p.y_mm, p.z_mm);
+        const geometry::PointClassification result = geometry::classify_at_pose(tool, pose.tip_mm, pose.axis, point);
+        if (result.contact == geometry::PointContact::BadTree) {
+          return Walk::BadTree;
+        }
+        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result)) {
+          return Walk::Stopped;
+        }
+      }
+      continue;
+    }
+    if (size + 2 > stack.size()) {
+      return Walk::BadTree;  // deeper than the loader allows: the tables were not loaded by it
+    }
+    stack[size++] = node.right_child;
+    stack[size++] = index + 1;
+  }
+  return Walk::Finished;
+}
+
+Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
+  const tables::PackedPoint& n = part.normals[point];
+  return {n.x_mm, n.y_mm, n.z_mm};
+}
+
+
+
+}  // namespace
+
+ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pose, const ContactParameters& parameters) {
+  ContactResult result{QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  if (!pose_is_usable(pose)) {
+    result.status = QueryStatus::BadInput;
+    return result;
+  }
+  const double k_world = parameters.stiffness_n_per_device_mm * parameters.device_mm_per_world_mm;
+  const Eigen::Vector3d centre = pose.tip_mm + parameters.compliance_centre_mm * pose.axis;
+  Eigen::Vector3d force_sum = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque_sum = Eigen::Vector3d::Zero();
+  const auto count_depth = [&](std::uint32_t i, double depth) {
+    ++result.penetrating_points;
+    if (depth > result.max_depth_mm) {
+      result.max_depth_mm = depth;
+      result.deepest_point = i;
+    }
+  };
+  const auto visit_point = [&](std::uint32_t i, const geometry::PointClassification& c) {
+    if (c.contact != geometry::PointContact::Penetrating) {
+      return true;
+    }
+    count_depth(i, c.depth_mm);
+    // The part pushes the tool out along the point's normal; the tool's own escape direction says
+    // the same from the other side. Their average is robust where one of them is poor.
+    Eigen::Vector3d direction = normal_of(part, i) - c.escape_direction;
+    const double length = direction.norm();
+    if (length < kNoDirection) {
+      return true;  // the two disagree completely: this point gives no direction
+    }
+    direction /= length;
+    const Eigen::Vector3d force = k_world * c.depth_mm * direction;
+    const tables::PackedPoint& p = part.points[i];
+    force_sum += force;
+    torque_sum += (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).cross(force);
+    return true;
+  };
+  // The same per point as visit_point, lane-wise over the leaf (single-precision sums in an order
+  // fixed by the build, so the same inputs still give the same bits).
+  const auto visit_leaf = [&](const LeafContacts& leaf) {
+    if (leaf.penetrating == 0) {
+      return true;
+    }
+    result.penetrating_points += leaf.penetrating;
+    if (leaf.max_depth_mm > result.max_depth_mm) {
+      result.max_depth_mm = leaf.max_depth_mm;
+      result.deepest_point = leaf.first + leaf.deepest_lane;
+    }
+    const LeafForceSums sums = leaf_forces(leaf, k_world, parameters.compliance_centre_mm);
+    force_sum += sums.force;
+    torque_sum += sums.torque;
+    return true;
+  };
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);
+  if (walk == Walk::BadTree) {
+    return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  }
+  const double magnitude = force_sum.norm();
+  if (magnitude > 0.0) {
+    const double scale = k_world * result.max_depth_mm / magnitude;
+    result.force_n = scale * force_sum;
+    result.torque_nmm = scale * torque_sum;
+  }
+  return result;
+}
+
+Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
+  if (!pose_is_usable(pose)) {
+    return Legality::Fault;
+  }
+  const Walk walk = walk_points_in_tool(
+      part, part.tool, pose, Wanted::Penetrating,
+      [](std::uint32_t, const geometry::PointClassification& c) {
+        return c.contact != geometry::PointContact::Penetrating;
+      },
+      [](const LeafContacts& leaf) { return leaf.penetrating == 0; });
+  switch (walk) {
+    case Walk::Finished:
+      return Legality::Legal;
+    case Walk::Stopped:
+      return Legality::Illegal;
+    case Walk::BadTree:
+      break;
+  }
+  return Legality::Fault;
+}
+
+std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolBsp& contact_tool, const ToolPose& pose,
+                           double contact_tolerance_mm, TriangleSet& touched) {
+  if (!pose_is_usable(pose)) {
+    return 0;
+  }
+  const std::size_t before = touched.count();
+  const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
+  static_cast<void>(walk_points_in_tool(
+      part, contact_tool, inflated, Wanted::InTool,
+      [&](std::uint32_t i, const geometry::PointClassification&) {
+        touched.insert(part.triangle_ids[i]);
+        return true;
+      },
+      [&](const LeafContacts& leaf) {
+        for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+          if ((leaf.in_tool >> lane) & 1U) {
+            touched.insert(part.triangle_ids[leaf.first + lane]);
+          }
+        }
+        return true;
+      }));
+  return static_cast<std::uint32_t>(touched.count() - before);
+}
+
+bool build_contact_tool(const geometry::ToolSpec& spec, double contact_tolerance_mm, geometry::ToolBsp& contact_tool) {
+  geometry::ToolSpec inflated = spec;
+  inflated.diameter_mm += 2.0 * contact_tolerance_mm;
+  inflated.flute_length_mm += contact_tolerance_mm;
+  inflated.corner_radius_mm += spec.kind == geometry::CutterKind::BullNose ? contact_tolerance_mm : 0.0;
+  inflated.holder_diameter_mm += 2.0 * contact_tolerance_mm;
+  inflated.holder_length_mm += contact_tolerance_mm;
+  return geometry::build_tool_bsp(inflated, contact_tool).ok;
+}
+
+}  // namespace stencil::engine

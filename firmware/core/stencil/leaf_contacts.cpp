@@ -1,0 +1,473 @@
+// Lane-wise depth, escape direction and force for the points of one leaf (upright tool), in
+// single precision, with every verdict checked in double precision where the lanes cannot tell.
+#include "firmware/core/stencil/leaf_contacts.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
+namespace stencil::engine {
+namespace {
+
+using geometry::SurfaceKind;
+constexpr std::uint32_t kLanes = tables::kMaxLeafPoints;
+
+// As in classify_at_pose: below this radius a point's radial direction is meaningless, and below
+// this distance from a sphere's or torus's centre its gradient is.
+constexpr float kOnAxisRadius_mm = 1e-12F;
+constexpr float kDegenerateDistance_mm = 1e-12F;
+constexpr float kInvSqrt2 = 0.70710678F;
+constexpr float kTolerance_mm = static_cast<float>(geometry::kSurfaceTolerance_mm);
+
+// The loops below are plain loops over the 32 lanes, which the compiler vectorises (selects become
+// blends); sums and maxima are taken in a fixed order of eight partial lanes, since the compiler
+// may not reorder a floating-point reduction itself. The same binary gives the same bits.
+constexpr std::uint32_t kPartials = 8;
+
+float lane_sum(const LeafLanes& a) {
+  std::array<float, kPartials> partial{};
+  for (std::uint32_t base = 0; base < kLanes; base += kPartials) {
+    for (std::uint32_t j = 0; j < kPartials; ++j) {
+      partial[j] += a[base + j];
+    }
+  }
+  return ((partial[0] + partial[4]) + (partial[2] + partial[6])) + ((partial[1] + partial[5]) + (partial[3] + partial[7]));
+}
+
+float lane_max(const LeafLanes& a) {
+  std::array<float, kPartials> partial{};
+  for (std::uint32_t j = 0; j < kPartials; ++j) {
+    partial[j] = a[j];
+  }
+  for (std::uint32_t base = kPartials; base < kLanes; base += kPartials) {
+    for (std::uint32_t j = 0; j < kPartials; ++j) {
+      partial[j] = std::max(partial[j], a[base + j]);
+    }
+  }
+  float best = partial[0];
+  for (std::uint32_t j = 1; j < kPartials; ++j) {
+    best = std::max(best, partial[j]);
+  }
+  return best;
+}
+
+// Per-lane verdicts, -1 where true: what the vectorised compares write, packed into a LaneMask.
+using LaneFlags = std::array<std::int32_t, kLanes>;
+
+LaneMask pack(const LaneFlags& flags) {
+#if defined(__AVX2__)
+  LaneMask mask = 0;
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    const __m256 block = _mm256_castsi256_ps(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(flags.data() + base)));
+    mask |= static_cast<LaneMask>(_mm256_movemask_ps(block)) << base;
+  }
+  return mask;
+#else
+  LaneMask mask = 0;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    mask |= flags[lane] != 0 ? LaneMask{1} << lane : 0U;
+  }
+  return mask;
+#endif
+}
+
+LaneMask lanes_below(std::uint32_t count) { return count >= kLanes ? ~LaneMask{0} : (LaneMask{1} << count) - 1U; }
+
+// Calls visit(lane) for each lane of the mask, lowest first.
+template <typename Visit>
+void for_each_lane(LaneMask mask, Visit&& visit) {
+  while (mask != 0) {
+    visit(static_cast<std::uint32_t>(std::countr_zero(mask)));
+    mask &= mask - 1U;
+  }
+}
+
+// The largest error of a float depth against the double one, for a leaf of this size and a
+// surface with these numbers: each of the few roundings on the way (the offset, squares, sums, a
+// square root or two, the difference with the radius) is at most half a float ulp of a quantity no
+// larger than `scale`; 2^-19 of it is 32 half-ulps, several times what the longest chain (a torus)
+// can reach.
+float band_for(const LeafContacts& leaf, const geometry::ImplicitSurface& surface) {
+  const double scale = static_cast<double>(leaf.magnitude_mm) + std::abs(surface.center_z_mm) +
+                       std::abs(surface.center_r_mm) + std::abs(surface.radius_mm);
+  return static_cast<float>(0x1p-19 * scale + 2.0 * geometry::kSurfaceTolerance_mm);
+}
+
+// The double-precision offset of a lane's point from the tip, as classify_at_pose computes it.
+struct ExactOffset {
+  double x, y, z;
+};
+ExactOffset exact_offset(const LeafContacts& leaf, std::uint32_t lane) {
+  const tables::PackedPoint& p = leaf.points[lane];
+  return {double{p.x_mm} - leaf.tip_mm.x(), double{p.y_mm} - leaf.tip_mm.y(), double{p.z_mm} - leaf.tip_mm.z()};
+}
+
+// The lane's interior distance to the surface in double precision: classify_meridian's number for
+// a point in the surface's region.
+double exact_depth(const LeafContacts& leaf, std::uint32_t lane, const geometry::ImplicitSurface& surface) {
+  const ExactOffset o = exact_offset(leaf, lane);
+  return geometry::interior_distance(surface, {std::sqrt(o.x * o.x + o.y * o.y), o.z});
+}
+
+// The meridian escape direction (radial, axial) turned into the world: radial along (x, y) / r,
+// or along +y on the axis (classify_at_pose's fixed perpendicular to +z).
+void escape_to_world(const LeafLanes& r, const LeafLanes& radial, const LeafLanes& axial, LeafContacts& leaf) {
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    const bool on_axis = !(r[lane] > kOnAxisRadius_mm);
+    const float inverse = 1.0F / std::max(r[lane], kOnAxisRadius_mm);
+    leaf.ex[lane] = on_axis ? 0.0F : radial[lane] * (leaf.x[lane] * inverse);
+    leaf.ey[lane] = on_axis ? radial[lane] : radial[lane] * (leaf.y[lane] * inverse);
+    leaf.ez[lane] = axial[lane];
+  }
+}
+
+void radii_of(const LeafContacts& leaf, LeafLanes& r) {
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    r[lane] = std::sqrt(leaf.x[lane] * leaf.x[lane] + leaf.y[lane] * leaf.y[lane]);
+  }
+}
+
+// Depth, escape and in_tool of every lane from one region's surface; a lane whose float depth is
+// within the band of the surface is settled in double precision. Returns false on a non-finite
+// result. The lanes past count are left to summarise().
+bool surface_contacts(const geometry::ImplicitSurface& surface, bool or_outside, LeafContacts& leaf) {
+  const float sign = surface.solid_side == geometry::SolidSide::Below ? 1.0F : -1.0F;
+  const auto centre_z = static_cast<float>(surface.center_z_mm);
+  const auto centre_r = static_cast<float>(surface.center_r_mm);
+  const auto radius = static_cast<float>(surface.radius_mm);
+  LeafLanes f;  // the surface's natural function
+  switch (surface.kind) {
+    case SurfaceKind::PlaneZ:
+      for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+        f[lane] = leaf.z[lane] - centre_z;
+        leaf.ex[lane] = 0.0F;
+        leaf.ey[lane] = 0.0F;
+        leaf.ez[lane] = sign;
+      }
+      break;
+    case SurfaceKind::Cylinder: {
+      LeafLanes r, radial, axial;
+      radii_of(leaf, r);
+      for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+        f[lane] = r[lane] - radius;
+        radial[lane] = sign;
+        axial[lane] = 0.0F;
+      }
+      escape_to_world(r, radial, axial, leaf);
+      break;
+    }
+    case SurfaceKind::Sphere:
+      // Centred on the axis: the meridian gradient (r, dz) / length is the 3-D one (x, y, dz) / length.
+      for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+        const float dz = leaf.z[lane] - centre_z;
+        const float length = std::sqrt(leaf.x[lane] * leaf.x[lane] + leaf.y[lane] * leaf.y[lane] + dz * dz);
+        f[lane] = length - radius;
+        // At the centre: classify_at_pose's (1, -1) / sqrt(2) in the meridian, radial along +y.
+        const bool degenerate = !(length >= kDegenerateDistance_mm);
+        const float inverse = sign / std::max(length, kDegenerateDistance_mm);
+        leaf.ex[lane] = degenerate ? 0.0F : leaf.x[lane] * inverse;
+        leaf.ey[lane] = degenerate ? kInvSqrt2 : leaf.y[lane] * inverse;
+        leaf.ez[lane] = degenerate ? -kInvSqrt2 : dz * inverse;
+      }
+      break;
+    case SurfaceKind::Torus: {
+      LeafLanes r, radial, axial;
+      radii_of(leaf, r);
+      for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+        const float dr = r[lane] - centre_r;
+        const float dz = leaf.z[lane] - centre_z;
+        const float length = std::sqrt(dr * dr + dz * dz);
+        f[lane] = length - radius;
+        const bool degenerate = !(length >= kDegenerateDistance_mm);
+        const float inverse = sign / std::max(length, kDegenerateDistance_mm);
+        radial[lane] = degenerate ? kInvSqrt2 : dr * inverse;
+        axial[lane] = degenerate ? -kInvSqrt2 : dz * inverse;
+      }
+      escape_to_world(r, radial, axial, leaf);
+      break;
+    }
+    default:
+      return false;
+  }
+  const float band = band_for(leaf, surface);
+  LaneFlags penetrating, in_tool, uncertain;
+  LeafLanes check;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    const float depth = -sign * f[lane];  // the interior distance to the region's surface
+    leaf.depth[lane] = depth > kTolerance_mm ? depth : 0.0F;
+    penetrating[lane] = depth > kTolerance_mm ? -1 : 0;
+    // Straddling the region's boundary, a point is in the tool exactly when the boundary test that
+    // leads to the region passes: -tolerance <= that same interior distance.
+    in_tool[lane] = !or_outside || depth >= -kTolerance_mm ? -1 : 0;
+    uncertain[lane] = std::abs(depth) <= band ? -1 : 0;
+    check[lane] = f[lane] + leaf.ex[lane] + leaf.ey[lane] + leaf.ez[lane];
+  }
+  // An infinity or NaN anywhere makes the sum non-finite (inf - inf is NaN).
+  if (!std::isfinite(lane_sum(check))) {
+    return false;
+  }
+  const LaneMask valid = lanes_below(leaf.count);
+  leaf.penetrating_lanes = pack(penetrating) & valid;
+  leaf.in_tool = pack(in_tool) & valid;
+  for_each_lane(pack(uncertain) & valid, [&](std::uint32_t lane) {
+    const double depth = exact_depth(leaf, lane, surface);
+    const LaneMask bit = LaneMask{1} << lane;
+    const bool deeper = depth > geometry::kSurfaceTolerance_mm;
+    leaf.depth[lane] = deeper ? static_cast<float>(depth) : 0.0F;
+    leaf.penetrating_lanes = deeper ? leaf.penetrating_lanes | bit : leaf.penetrating_lanes & ~bit;
+    leaf.in_tool = (!or_outside || depth >= -geometry::kSurfaceTolerance_mm) ? leaf.in_tool | bit : leaf.in_tool & ~bit;
+  });
+  return true;
+}
+
+void clear_contacts(LeafContacts& leaf) {
+  leaf.depth.fill(0.0F);
+  leaf.ex.fill(0.0F);
+  leaf.ey.fill(0.0F);
+  leaf.ez.fill(0.0F);
+  leaf.in_tool = 0;
+  leaf.penetrating_lanes = 0;
+}
+
+// Zeroes the depth past count (so sums may run over every lane), counts the penetrating lanes and
+// finds the deepest in double precision: every penetrating lane whose float depth is within twice
+// the band of the float maximum may be it. exact(lane) gives a lane's double-precision depth.
+template <typename ExactDepth>
+void summarise(float band, ExactDepth&& exact, LeafContacts& leaf) {
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    leaf.depth[lane] = lane < leaf.count ? leaf.depth[lane] : 0.0F;
+  }
+  leaf.penetrating = static_cast<std::uint32_t>(std::popcount(leaf.penetrating_lanes));
+  leaf.max_depth_mm = 0.0;
+  leaf.deepest_lane = 0;
+  if (leaf.penetrating == 0) {
+    return;
+  }
+  const float floor = lane_max(leaf.depth) - 2.0F * band;
+  LaneFlags near_deepest;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    near_deepest[lane] = leaf.depth[lane] >= floor ? -1 : 0;
+  }
+  for_each_lane(pack(near_deepest) & leaf.penetrating_lanes, [&](std::uint32_t lane) {
+    const double depth = exact(lane);
+    if (depth > leaf.max_depth_mm) {
+      leaf.max_depth_mm = depth;
+      leaf.deepest_lane = lane;
+    }
+  });
+}
+
+// Widens `count` packed triples (x, y, z floats one after another) into three lanes, less
+// `high` and then `low` per axis. Lanes past count repeat the last triple, so every lane holds
+// finite numbers.
+void widen_triples(const float* packed, std::uint32_t count, const std::array<float, 3>& high,
+                   const std::array<float, 3>& low, float* x, float* y, float* z) {
+#if defined(__AVX2__)
+  // Eight triples at a time: three loads, two blends and a permute per axis, where the compiler
+  // would insert each float on its own. Lane i of the blend of a, b, c below holds x, y or z of a
+  // different triple; the permute puts them in order. The block holding the leaf's end loads only
+  // its own floats (masked loads never touch memory outside the mask), and its lanes past count
+  // take the last triple. Every lane is written by one whole-vector store, which the kernels' loads
+  // right after are forwarded from.
+  const __m256i x_order = _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5);
+  const __m256i y_order = _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6);
+  const __m256i z_order = _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7);
+  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const float* last = packed + 3 * (count - 1);
+  const __m256 last_x = _mm256_set1_ps(last[0]), last_y = _mm256_set1_ps(last[1]), last_z = _mm256_set1_ps(last[2]);
+  const __m256 high_x = _mm256_set1_ps(high[0]), high_y = _mm256_set1_ps(high[1]), high_z = _mm256_set1_ps(high[2]);
+  const __m256 low_x = _mm256_set1_ps(low[0]), low_y = _mm256_set1_ps(low[1]), low_z = _mm256_set1_ps(low[2]);
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    __m256 xs = last_x, ys = last_y, zs = last_z;
+    if (base < count) {
+      const float* block = packed + 3 * base;
+      __m256 a, b, c;  // x0 y0 z0 x1 y1 z1 x2 y2 | z2 x3 y3 z3 x4 y4 z4 x5 | y5 z5 x6 y6 z6 x7 y7 z7
+      const std::uint32_t triples = count - base;
+      if (triples >= 8) {
+        a = _mm256_loadu_ps(block);
+        b = _mm256_loadu_ps(block + 8);
+        c = _mm256_loadu_ps(block + 16);
+      } else {
+        const __m256i floats = _mm256_set1_epi32(static_cast<int>(3 * triples));
+        a = _mm256_maskload_ps(block, _mm256_cmpgt_epi32(floats, lane_index));
+        b = _mm256_maskload_ps(block + 8, _mm256_cmpgt_epi32(floats, _mm256_add_epi32(lane_index, _mm256_set1_epi32(8))));
+        c = _mm256_maskload_ps(block + 16,
+                               _mm256_cmpgt_epi32(floats, _mm256_add_epi32(lane_index, _mm256_set1_epi32(16))));
+      }
+      xs = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24), x_order);
+      ys = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x24), c, 0x49), y_order);
+      zs = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x49), c, 0x92), z_order);
+      if (triples < 8) {
+        const __m256 past = _mm256_castsi256_ps(
+            _mm256_cmpgt_epi32(lane_index, _mm256_set1_epi32(static_cast<int>(triples) - 1)));
+        xs = _mm256_blendv_ps(xs, last_x, past);
+        ys = _mm256_blendv_ps(ys, last_y, past);
+        zs = _mm256_blendv_ps(zs, last_z, past);
+      }
+    }
+    _mm256_storeu_ps(x + base, _mm256_sub_ps(_mm256_sub_ps(xs, high_x), low_x));
+    _mm256_storeu_ps(y + base, _mm256_sub_ps(_mm256_sub_ps(ys, high_y), low_y));
+    _mm256_storeu_ps(z + base, _mm256_sub_ps(_mm256_sub_ps(zs, high_z), low_z));
+  }
+  return;
+#else
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    const std::uint32_t from = 3 * std::min(lane, count - 1);
+    x[lane] = (packed[from] - high[0]) - low[0];
+    y[lane] = (packed[from + 1] - high[1]) - low[1];
+    z[lane] = (packed[from + 2] - high[2]) - low[2];
+  }
+#endif
+}
+
+}  // namespace
+
+void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, const Eigen::Vector3d& tip_mm,
+               LeafContacts& leaf) {
+  leaf.first = first;
+  leaf.count = count;
+  leaf.points = &part.points[first];
+  leaf.tip_mm = tip_mm;
+  // The tip as a float and the float of what that leaves out: (p - high) - low is the offset to
+  // within a rounding of its own size, however far the part is from the origin.
+  const std::array<float, 3> high = {static_cast<float>(tip_mm.x()), static_cast<float>(tip_mm.y()),
+                                     static_cast<float>(tip_mm.z())};
+  const std::array<float, 3> low = {static_cast<float>(tip_mm.x() - double{high[0]}),
+                                    static_cast<float>(tip_mm.y() - double{high[1]}),
+                                    static_cast<float>(tip_mm.z() - double{high[2]})};
+  static_assert(sizeof(tables::PackedPoint) == 3 * sizeof(float));
+  widen_triples(&part.points[first].x_mm, count, high, low, leaf.x.data(), leaf.y.data(), leaf.z.data());
+  widen_triples(&part.normals[first].x_mm, count, {}, {}, leaf.nx.data(), leaf.ny.data(), leaf.nz.data());
+  LeafLanes size;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    size[lane] = std::abs(leaf.x[lane]) + std::abs(leaf.y[lane]) + std::abs(leaf.z[lane]);
+  }
+  leaf.magnitude_mm = lane_max(size);
+}
+
+bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside, LeafContacts& leaf) {
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
+  if (!surface_contacts(surface, or_outside, leaf)) {
+    return false;
+  }
+  summarise(band_for(leaf, surface), [&](std::uint32_t lane) { return exact_depth(leaf, lane, surface); }, leaf);
+  return true;
+}
+
+namespace {
+
+const geometry::ImplicitSurface* part_surface(const geometry::ToolBsp& tool, const geometry::BoxPart& part) {
+  return part.cover == geometry::BoxCover::Outside ? nullptr : &tool.surfaces[tool.regions[part.region].surface];
+}
+
+bool part_contacts(const geometry::ImplicitSurface* surface, const geometry::BoxPart& part, LeafContacts& leaf) {
+  if (surface == nullptr) {
+    clear_contacts(leaf);
+    return true;
+  }
+  return surface_contacts(*surface, part.cover == geometry::BoxCover::RegionOrOutside, leaf);
+}
+
+}  // namespace
+
+bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover, LeafContacts& leaf) {
+  const geometry::ImplicitSurface* below = part_surface(tool, cover.below);
+  const geometry::ImplicitSurface* above = part_surface(tool, cover.above);
+  // classify_meridian's partition test, on the same double-precision z: below when z - split < 0.
+  LaneMask is_below = 0;
+  for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+    is_below |= exact_offset(leaf, lane).z - cover.split_z_mm < 0.0 ? LaneMask{1} << lane : 0U;
+  }
+  if (!part_contacts(below, cover.below, leaf)) {
+    return false;
+  }
+  const LeafLanes depth = leaf.depth, ex = leaf.ex, ey = leaf.ey, ez = leaf.ez;
+  const LaneMask below_in_tool = leaf.in_tool, below_penetrating = leaf.penetrating_lanes;
+  if (!part_contacts(above, cover.above, leaf)) {
+    return false;
+  }
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    if ((is_below >> lane) & 1U) {
+      leaf.depth[lane] = depth[lane];
+      leaf.ex[lane] = ex[lane];
+      leaf.ey[lane] = ey[lane];
+      leaf.ez[lane] = ez[lane];
+    }
+  }
+  leaf.in_tool = (below_in_tool & is_below) | (leaf.in_tool & ~is_below);
+  leaf.penetrating_lanes = (below_penetrating & is_below) | (leaf.penetrating_lanes & ~is_below);
+  const float band = std::max(below != nullptr ? band_for(leaf, *below) : 0.0F,
+                              above != nullptr ? band_for(leaf, *above) : 0.0F);
+  // Only penetrating lanes are asked for, and those have a surface on their own side.
+  summarise(
+      band,
+      [&](std::uint32_t lane) {
+        const geometry::ImplicitSurface* surface = ((is_below >> lane) & 1U) != 0 ? below : above;
+        return surface != nullptr ? exact_depth(leaf, lane, *surface) : 0.0;
+      },
+      leaf);
+  return true;
+}
+
+bool mixed_leaf_contacts(const geometry::ToolBsp& tool, LeafContacts& leaf) {
+  LeafLanes r{}, radial{}, axial{};  // past count: zero, so no escape and no force
+  std::array<double, kLanes> exact{};
+  leaf.depth.fill(0.0F);
+  leaf.in_tool = 0;
+  leaf.penetrating_lanes = 0;
+  for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+    // No outline pre-filter here: it would drop points touching the surface from just outside,
+    // which the settled leaves keep; the tool tree decides them all alike, in double precision.
+    const ExactOffset o = exact_offset(leaf, lane);
+    const double r_exact = std::sqrt(o.x * o.x + o.y * o.y);
+    const geometry::MeridianClassification c = geometry::classify_meridian(tool, {r_exact, o.z});
+    if (c.contact == geometry::PointContact::BadTree) {
+      return false;
+    }
+    const bool inside = c.contact != geometry::PointContact::Outside;
+    const bool penetrating = c.contact == geometry::PointContact::Penetrating;
+    r[lane] = static_cast<float>(r_exact);
+    leaf.in_tool |= inside ? LaneMask{1} << lane : 0U;
+    leaf.penetrating_lanes |= penetrating ? LaneMask{1} << lane : 0U;
+    exact[lane] = penetrating ? c.depth_mm : 0.0;
+    leaf.depth[lane] = penetrating ? static_cast<float>(c.depth_mm) : 0.0F;  // > 0: depth > 1e-9
+    radial[lane] = inside ? static_cast<float>(c.escape.radial) : 0.0F;
+    axial[lane] = inside ? static_cast<float>(c.escape.axial) : 0.0F;
+  }
+  escape_to_world(r, radial, axial, leaf);
+  // The float depths are roundings of the exact ones: within a float ulp of the deepest.
+  summarise(static_cast<float>(0x1p-23 * static_cast<double>(lane_max(leaf.depth))),
+            [&](std::uint32_t lane) { return exact[lane]; }, leaf);
+  return true;
+}
+
+LeafForceSums leaf_forces(const LeafContacts& leaf, double k_world, double centre_height_mm) {
+  const auto k = static_cast<float>(k_world);
+  const auto height = static_cast<float>(centre_height_mm);
+  constexpr auto kNoDirectionF = static_cast<float>(kNoDirection);
+  LeafLanes fx, fy, fz, tx, ty, tz;
+  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    const float vx = leaf.nx[lane] - leaf.ex[lane];
+    const float vy = leaf.ny[lane] - leaf.ey[lane];
+    const float vz = leaf.nz[lane] - leaf.ez[lane];
+    const float length = std::sqrt(vx * vx + vy * vy + vz * vz);
+    // Zero where the normal and the escape direction cancel (no direction) or nothing penetrates.
+    const float scale = length >= kNoDirectionF ? k * leaf.depth[lane] / length : 0.0F;
+    fx[lane] = scale * vx;
+    fy[lane] = scale * vy;
+    fz[lane] = scale * vz;
+    // About the compliance centre, up the axis from the tip: r = offset - (0, 0, height).
+    const float rz = leaf.z[lane] - height;
+    tx[lane] = leaf.y[lane] * fz[lane] - rz * fy[lane];
+    ty[lane] = rz * fx[lane] - leaf.x[lane] * fz[lane];
+    tz[lane] = leaf.x[lane] * fy[lane] - leaf.y[lane] * fx[lane];
+  }
+  return {Eigen::Vector3d(double{lane_sum(fx)}, double{lane_sum(fy)}, double{lane_sum(fz)}),
+          Eigen::Vector3d(double{lane_sum(tx)}, double{lane_sum(ty)}, double{lane_sum(tz)})};
+}
+
+}  // namespace stencil::engine

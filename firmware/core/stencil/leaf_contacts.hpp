@@ -1,0 +1,90 @@
+// One leaf of the part's tree against the upright tool, all its points at once: depth, escape
+// direction, force and torque, lane by lane in single precision so each instruction serves eight
+// points, with every decision (which points penetrate, which touch, which is deepest and how deep)
+// settled in double precision. This is where the query spends its time in deep contact.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include <Eigen/Core>
+
+#include "firmware/core/geometry/meridian_box.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/tables/part_tables.hpp"
+#include "firmware/core/tables/table_format.hpp"
+
+namespace stencil::engine {
+
+// Why single precision: the points are stored as floats, a float lane is half as wide as a double
+// and its square root and division several times cheaper, and the deep-contact cycle at 1e6 points
+// is bound by exactly that arithmetic. A float depth is within a bound of the double one that
+// grows with the leaf's size (LeafContacts::band_mm); every point whose float depth lies within
+// that band of the tool's surface, and every point that may be the deepest, is computed again in
+// double precision, so the count, the touched set, the legality and the deepest depth are those of
+// the double-precision classification. Only the force and torque sums carry the float rounding
+// (relative error about 1e-6, far below anything the operator can feel).
+using LeafLanes = std::array<float, tables::kMaxLeafPoints>;
+using LaneMask = std::uint32_t;  // bit i for lane i
+static_assert(tables::kMaxLeafPoints <= 32, "a lane mask holds every lane of a leaf");
+
+// Below this length a point's normal and the tool's escape direction cancel: the point gives no
+// force direction (the same threshold for the per-point path of the query and the lanes).
+inline constexpr double kNoDirection = 1e-12;
+
+struct LeafContacts {
+  std::uint32_t first;                // table index of the leaf's first point
+  std::uint32_t count;                // its points (1 to 32); lanes past count repeat the last point
+  const tables::PackedPoint* points;  // the leaf's points in the tables, for the double-precision checks
+  Eigen::Vector3d tip_mm;             // the tool's tip the offsets are taken from
+  float magnitude_mm;                 // no lane's |x| + |y| + |z| is larger
+  alignas(32) LeafLanes x;            // offset of each point from the tip, world mm
+  alignas(32) LeafLanes y;
+  alignas(32) LeafLanes z;
+  alignas(32) LeafLanes nx;  // the points' normals
+  alignas(32) LeafLanes ny;
+  alignas(32) LeafLanes nz;
+  alignas(32) LeafLanes depth;  // > 0 exactly in the lanes that penetrate beyond kSurfaceTolerance_mm
+                                // (the double-precision verdict); 0 elsewhere and past count
+  alignas(32) LeafLanes ex;     // escape direction in world frame; 0 for points outside the tool
+  alignas(32) LeafLanes ey;
+  alignas(32) LeafLanes ez;
+  LaneMask in_tool;            // lanes touching or penetrating; none past count
+  LaneMask penetrating_lanes;  // lanes with depth > 0
+  std::uint32_t penetrating;   // how many
+  double max_depth_mm;        // the deepest lane's depth in double precision; 0 when none penetrates
+  std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
+};
+
+// Loads the leaf's points (as offsets from tip_mm) and normals into the lanes. count must be 1 to
+// kMaxLeafPoints and the run inside the tables (the walk checks it).
+void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, const Eigen::Vector3d& tip_mm,
+               LeafContacts& leaf);
+
+// Every point of the leaf lies in region `region` of the upright tool or, when `or_outside`,
+// either in it or outside the tool (geometry::classify_meridian_box's Region and RegionOrOutside):
+// depth and escape from that region's surface, with no walk of the tool tree. False when a result
+// is not finite (a damaged tool tree): a fault.
+[[nodiscard]] bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside,
+                                        LeafContacts& leaf);
+
+// The leaf straddles a plane z = split_z_mm of the tool tree (geometry::classify_meridian_box's
+// SplitAtZ): each side's part settled as above, and each point takes its own side's numbers. False
+// as above.
+[[nodiscard]] bool split_leaf_contacts(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                                       LeafContacts& leaf);
+
+// The leaf straddles the tool's tests: each point through the tool tree (classify_meridian, in
+// double precision), the arithmetic after it still over the lanes. False on a damaged tree.
+[[nodiscard]] bool mixed_leaf_contacts(const geometry::ToolBsp& tool, LeafContacts& leaf);
+
+// The sum over the leaf of each point's f_i = k_world * d_i along normalize(normal - escape), and
+// of its torque r_i x f_i about the point `centre_height_mm` up the axis from the tip (zero for a
+// point whose normal and escape direction cancel, or that does not penetrate).
+struct LeafForceSums {
+  Eigen::Vector3d force;
+  Eigen::Vector3d torque;
+};
+[[nodiscard]] LeafForceSums leaf_forces(const LeafContacts& leaf, double k_world, double centre_height_mm);
+
+}  // namespace stencil::engine
