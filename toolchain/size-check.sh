@@ -21,9 +21,9 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-# The file sets, in one place (globs from the repository root). When the runtime moves to its own
-# folder, change `runtime` (and `programs` if the mains move). A glob that matches nothing is skipped
-# (firmware/runtime/ has no .cpp yet); a file that matches must be in the compile database.
+# The file sets, in one place (globs from the repository root): the programs' mains, and the
+# runtime, the boards and the programs' other files. A glob that matches nothing is skipped; a file
+# that matches must be in the compile database.
 programs=(firmware/programs/*_main.cpp)
 runtime=(firmware/runtime/*.cpp board/sim/*.cpp board/sherline_suzuki/*.cpp firmware/programs/*.cpp)
 MAIN_LIMIT=150

@@ -10,6 +10,7 @@
 #include <cerrno>
 #include <cstring>
 #include <thread>
+#include <utility>
 
 #include "hal/posix_clock/monotonic_clock.hpp"
 
@@ -145,6 +146,16 @@ RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs peri
   });
   thread.join();
   return setup;
+}
+
+runtime::PeriodicRunner realtime_runner(const RealtimeOptions& options, std::function<void(const std::string&)> announce) {
+  return [options, announce = std::move(announce)](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
+                                                   const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle,
+                                                   std::string& refused) {
+    const RealtimeSetup setup = run_periodic(options, period_ns, stop, cycle, announce);
+    refused = setup.refused.empty() ? "" : "--require-rt: " + setup.refused;
+    return setup.refused.empty();
+  };
 }
 
 }  // namespace stencil::app

@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 
+#include "firmware/runtime/periodic_runner.hpp"
 #include "hal/clock.hpp"
 
 namespace stencil::app {
@@ -68,5 +69,10 @@ struct ThreadPriority {
 RealtimeSetup run_periodic(const RealtimeOptions& options, hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
                            const std::function<bool(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns)>& cycle,
                            const std::function<void(const std::string&)>& announce);
+
+// run_periodic as the runtime's PeriodicRunner: its lines go to `announce`; a refusal (only with
+// options.require) comes back as "--require-rt: <why>".
+[[nodiscard]] runtime::PeriodicRunner realtime_runner(const RealtimeOptions& options,
+                                                      std::function<void(const std::string&)> announce);
 
 }  // namespace stencil::app

@@ -1,0 +1,65 @@
+#include "board/sherline_suzuki/rig_devices.hpp"
+
+#include "hal/socketcan/can_frame_layout.hpp"
+#include "hal/socketcan/can_interface_bitrate.hpp"
+
+namespace stencil::board::sherline_suzuki {
+namespace {
+
+bool open_pio(const std::string& path, RigDevices& devices, std::string& error) {
+  devices.window = hal::pio_shared_memory::SharedWindowMapping::open(path, 0, true, error);
+  if (devices.window == nullptr) {
+    error = "the haptic device's PIO window: " + error;
+    return false;
+  }
+  devices.pio_device =
+      std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&devices.window->window(), hal::kCornerOriginHapticRange);
+  devices.device = devices.pio_device.get();
+  return true;
+}
+
+bool open_can(const std::string& interface, RigDevices& devices, const std::function<void(const std::string&)>& note,
+              std::string& error) {
+  const canid_t ids[] = {hal::socketcan::kPoseAId, hal::socketcan::kPoseBId, hal::socketcan::kStatusId};
+  const int fd = hal::socketcan::open_can_raw_socket(interface, ids, 3, error);
+  if (fd < 0) {
+    error = "the haptic device's CAN link: " + error;
+    return false;
+  }
+  devices.channel = std::make_unique<hal::socketcan::FdCanChannel>(fd);
+  // A bus too slow for a period's frames is refused here, not found out as late poses in the cycle.
+  std::string bitrate_note;
+  if (!hal::socketcan::check_can_bitrate(interface, bitrate_note, error)) {
+    error = "the haptic device's CAN link: " + error;
+    return false;
+  }
+  note(bitrate_note);
+  devices.can_device =
+      std::make_unique<hal::socketcan::SocketCanHapticDevice>(devices.channel.get(), hal::kCornerOriginHapticRange);
+  devices.device = devices.can_device.get();
+  return true;
+}
+
+}  // namespace
+
+bool is_haptic_link_name(const std::string& haptic) {
+  return (haptic.rfind("pio:", 0) == 0 || haptic.rfind("can:", 0) == 0) && haptic.size() > 4;
+}
+
+bool open_rig_devices(const std::string& serial_path, const std::string& haptic, RigDevices& devices,
+                      const std::function<void(const std::string&)>& note, std::string& error) {
+  char port_error[256] = {};
+  if (!devices.port.open(serial_path.c_str(), port_error)) {
+    error = std::string("the mill's CY545: ") + port_error;
+    return false;
+  }
+  const bool opened = haptic.rfind("pio:", 0) == 0 ? open_pio(haptic.substr(4), devices, error)
+                                                   : open_can(haptic.substr(4), devices, note, error);
+  if (!opened) {
+    return false;
+  }
+  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, hal::cy545::Cy545Config{});
+  return true;
+}
+
+}  // namespace stencil::board::sherline_suzuki

@@ -1,0 +1,129 @@
+#include "firmware/programs/rig_options.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <vector>
+
+#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_devices.hpp"
+#include "firmware/programs/output_probe.hpp"
+
+namespace stencil::app {
+namespace {
+
+// "X,Y,Z" (or six numbers for a block) as finite numbers, all of each field: false otherwise.
+bool parse_numbers(const std::string& text, std::vector<double>& out, std::size_t count) {
+  out.clear();
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t comma = std::min(text.find(',', at), text.size());
+    const std::string field = text.substr(at, comma - at);
+    char* end = nullptr;
+    const double value = std::strtod(field.c_str(), &end);
+    if (field.empty() || end != field.c_str() + field.size() || !std::isfinite(value)) {
+      return false;
+    }
+    out.push_back(value);
+    at = comma + 1;
+  }
+  return out.size() == count;
+}
+
+void add_job_options(CLI::App& app, RigOptions& o) {
+  app.add_option("--tables", o.tables_path, "the part's .stbl")->required();
+  app.add_option("--serial", o.serial_path, "the CY545's serial port, e.g. /dev/ttyS0")->required();
+  app.add_option("--haptic", o.haptic, "the haptic link: pio:/dev/uioN or can:IFACE")->required();
+  app.add_flag("--require-rt", o.require_rt, "refuse to run without PREEMPT_RT and SCHED_FIFO");
+  app.add_option("--priority", o.priority, "the cycle thread's SCHED_FIFO priority")->check(CLI::Range(1, 99))->capture_default_str();
+  app.add_option("--cpu", o.cpu, "pin the cycle thread to this CPU (the other threads keep off it)")->check(CLI::NonNegativeNumber);
+  app.add_option("--work-offset", o.offset_text,
+                 "X,Y,Z: where the tool tip is in the part's coordinates (mm) with the machine at home, from the touch-off")
+      ->capture_default_str();
+  app.add_option("--tool-stick-out", o.stick_out, "the tool's stick-out below the holder (mm); with --reference-stick-out")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--reference-stick-out", o.reference_stick_out,
+                 "the stick-out of the tool the touch-off was made with (mm): a longer tool puts the tip lower")
+      ->check(CLI::Range(0.0, 100.0))
+      ->capture_default_str();
+  app.add_option("--stock", o.stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the whole workspace)");
+}
+
+void add_record_options(CLI::App& app, RigOptions& o) {
+  app.add_option("--report", o.report_path, "write the run's figures here as JSON");
+  app.add_option("--journal", o.journal_path,
+                 "record the job here: every cycle's sample, virtual tool and force, every machine command (written "
+                 "before it is sent), every safe-state event (default: stencil-rig-YYYYMMDD-HHMMSS.journal in the "
+                 "current folder, named after the start time)");
+  app.add_flag("--no-journal", o.no_journal, "record no journal (the job cannot be resumed)");
+  app.add_option("--resume", o.resume_path,
+                 "carry on the job this journal recorded (after a crash, a kill or a safe state), with the same --tables, "
+                 "--work-offset, stick-outs and --stock: the touched set and the model of the machined stock are rebuilt "
+                 "from it, the mill homes again (Z first, out of the stock) and the cut carries on from wherever the "
+                 "operator takes the handle; the journal carries on in the same file and the report covers the whole job");
+  app.add_option("--duration", o.duration_s, "stop after this many seconds (default: until SIGINT, SIGTERM, SIGHUP or SIGQUIT)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+bool read_stock(const std::string& text, control::StockBlock& stock, std::string& error) {
+  const auto& workspace = board::sherline_suzuki::kRig.workspace_mm;
+  stock = {{0.0, 0.0, 0.0}, {workspace[0], workspace[1], workspace[2]}};
+  if (text.empty()) {
+    return true;
+  }
+  std::vector<double> numbers;
+  bool inside = parse_numbers(text, numbers, 6);
+  for (int axis = 0; inside && axis < 3; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= workspace[a];
+  }
+  if (!inside) {
+    error = "--stock " + text +
+            ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace [0,50]x[0,25]x[0,25]";
+    return false;
+  }
+  stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
+  return true;
+}
+
+}  // namespace
+
+void add_rig_options(CLI::App& app, RigOptions& options) {
+  add_job_options(app, options);
+  add_record_options(app, options);
+  add_display_options(app, options.display);
+}
+
+bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& offset, control::StockBlock& stock,
+                       std::string& error) {
+  if (!check_display_options(o.display, error)) {
+    return false;
+  }
+  // (CLI11's range check lets a NaN through: every comparison with it is false.)
+  if (!std::isfinite(o.stick_out) || !std::isfinite(o.reference_stick_out)) {
+    error = "--tool-stick-out and --reference-stick-out: expected a length in mm from 0 to 100";
+    return false;
+  }
+  std::vector<double> numbers;
+  if (!parse_numbers(o.offset_text, numbers, 3)) {
+    error = "--work-offset " + o.offset_text + ": expected X,Y,Z in mm";
+    return false;
+  }
+  offset.home_world_mm = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
+  offset.tool_stick_out_mm = o.stick_out;
+  offset.reference_stick_out_mm = o.reference_stick_out;
+  if (!read_stock(o.stock_text, stock, error) || (!o.report_path.empty() && !probe_writable(o.report_path, error))) {
+    return false;
+  }
+  if (!board::sherline_suzuki::is_haptic_link_name(o.haptic)) {
+    error = "--haptic " + o.haptic + ": expected pio:/dev/uioN or can:IFACE";
+    return false;
+  }
+  if (!o.resume_path.empty() && (!o.journal_path.empty() || o.no_journal)) {
+    error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace stencil::app

@@ -1,0 +1,41 @@
+// stencil-rig's command line: every option with its help, and what the options say about the job
+// (the work offset, the stock), checked before anything is opened.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "board/sherline_suzuki/rig_job.hpp"
+#include "firmware/core/control/commanded_stock.hpp"
+#include "firmware/programs/display_option.hpp"
+
+namespace stencil::app {
+
+struct RigOptions {
+  std::string tables_path;
+  std::string serial_path;
+  std::string haptic;         // pio:/dev/uioN or can:IFACE
+  bool require_rt = false;
+  int priority = 80;
+  int cpu = -1;
+  std::string offset_text = "50,25,25";
+  double stick_out = 0.0;
+  double reference_stick_out = 0.0;
+  std::string stock_text;     // empty: the whole workspace
+  std::string report_path;
+  std::string journal_path;
+  bool no_journal = false;
+  std::string resume_path;
+  double duration_s = 0.0;
+  DisplayOptions display;
+};
+
+void add_rig_options(CLI::App& app, RigOptions& options);
+
+// After parsing: the options checked and read into the job's work offset and stock block (the
+// report's path found writable). False with the message for the terminal.
+[[nodiscard]] bool check_rig_options(const RigOptions& options, board::sherline_suzuki::WorkOffset& offset,
+                                     control::StockBlock& stock, std::string& error);
+
+}  // namespace stencil::app

@@ -1,0 +1,139 @@
+#include "firmware/programs/sim_options.hpp"
+
+#include "sim/operator/operator_script.hpp"
+
+namespace stencil::app {
+namespace {
+
+void add_operator_options(CLI::App& app, SimOptions& o) {
+  app.add_option("--tables", o.tables_path, "the part's .stbl (default: the baked-in hex prism, ball end mill d = 3 mm)");
+  app.add_option("--operator", o.operator_path, "the operator's script: CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] in device space");
+  app.add_option("--pattern", o.pattern_name, "the operator's pattern when there is no --operator file")
+      ->check(CLI::IsMember({"raster", "plunge", "thinwall", "random"}))
+      ->capture_default_str();
+  app.add_option("--seed", o.seed, "the random pattern's seed")->capture_default_str();
+  app.add_option("--moves", o.moves, "the random pattern's number of moves (200 take about 40 simulated minutes)")
+      ->check(CLI::Range(1, 1'000'000))
+      ->capture_default_str();
+  app.add_option("--duration", o.duration_s, "simulated seconds to run (default: the script's length)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--fast", o.fast, "virtual clock, as fast as the machine allows, deterministic");
+  app.add_option("--speed", o.speed,
+                 "N x real time. 1: the cycle on a SCHED_FIFO thread at 1 kHz and the machine and the fake CY545 on "
+                 "threads of their own, on the wall clock (what make latency measures); any other N: the --fast "
+                 "virtual clock held to N simulated seconds per second, deterministic, so a person can watch")
+      ->check(CLI::Range(1e-3, 1e6));
+  app.add_option("--priority", o.priority, "real time: the cycle thread's SCHED_FIFO priority")
+      ->check(CLI::Range(1, 99))
+      ->capture_default_str();
+  app.add_option("--cpu", o.cpu, "real time: pin the cycle thread to this CPU")->check(CLI::NonNegativeNumber);
+  app.add_flag("--require-rt", o.require_rt, "real time: refuse to run without SCHED_FIFO and locked memory");
+  app.add_option("--report", o.report_path, "the JSON report; the picture goes beside it as .svg")->capture_default_str();
+  app.add_flag("--until-complete", o.until_complete,
+               "end once every reachable triangle is touched and the mill has caught up with the virtual tool");
+  app.add_option("--stock", o.stock_text, "the stock block X0,Y0,Z0,X1,Y1,Z1 in world mm (default: the part's box grown by 2 mm)");
+  app.add_option("--inject", o.inject_text,
+                 "KIND@S: inject one fault S simulated seconds into the job (--fast or --speed N other than 1); KIND is " +
+                     board::sim::fault_kind_names(board::sim::FaultKindList::Sentence) +
+                     "; the report's fault section says when the safe state, zero force and the stopped mill followed");
+}
+
+void add_record_options(CLI::App& app, SimOptions& o) {
+  app.add_option("--journal", o.journal_path,
+                 "record the job here: every cycle's device sample, virtual tool and force, every machine command "
+                 "(written before it is sent) and every safe-state event, with a CRC-32 each, synced to the disk every "
+                 "second and at once on a safe state (default: stencil-sim-YYYYMMDD-HHMMSS.journal in the current "
+                 "folder, named after the start time; about 400 MB per simulated hour)");
+  app.add_flag("--no-journal", o.no_journal, "record no journal (the job cannot be resumed)");
+  app.add_option("--resume", o.resume_path,
+                 "carry on the job this journal recorded (after a crash, a kill or a safe state), given the same "
+                 "--tables, --pattern, --seed, --operator and --stock: the touched set and the stock as machined are "
+                 "rebuilt from it, the machine homes again, the simulated operator goes back across at home's height "
+                 "and down to where the cut stopped and carries on with its script; the journal carries on in the "
+                 "same file and the report covers the whole job (--duration is then the whole job's)");
+  app.add_option("--replay", o.replay_path,
+                 "re-run the job this journal recorded, deterministically, on the virtual clock: each cycle reads "
+                 "exactly what the recorded cycle read from the device (every run of a resumed job in turn, each "
+                 "from the state the runs before it left); says whether every cycle's virtual tool came out bit for "
+                 "bit as recorded (exit 0) or where it first differed (exit 3). Writes the report and no journal");
+  app.add_option("--stock-csv", o.stock_csv_path,
+                 "write the machined stock's heights here at the end: one row of the Z-map per line (y rising), "
+                 "mm, cells of 0.05 mm from the stock's low corner");
+  app.add_option("--device-process", o.device_log_path,
+                 "LOG: with --haptic-transport pio only: the simulated device and the operator's hand run in a process of "
+                 "their own (on the virtual clock in lockstep with the cycle, so the job is the same job; in real time "
+                 "on the wall clock), so that if this one dies, even by SIGKILL, the device's own host watchdog zeroes "
+                 "the force; the device writes to LOG how long that took");
+  app.add_option("--trace", o.trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
+  app.add_option("--haptic-transport", o.transport,
+                 "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
+                 "SocketCAN code over a memfd or a socketpair")
+      ->check(CLI::IsMember({"direct", "pio", "can"}))
+      ->capture_default_str();
+}
+
+// --inject KIND@SECONDS, on the virtual clock only.
+bool check_inject(SimOptions& o, std::string& error) {
+  const std::size_t at = o.inject_text.find('@');
+  double at_s = 0.0;
+  if (at == std::string::npos || !board::sim::parse_fault_kind(o.inject_text.substr(0, at), o.fault.kind) ||
+      !sim::parse_finite_field(o.inject_text.substr(at + 1), at_s) || at_s < 0.0) {
+    error = "--inject " + o.inject_text + ": expected KIND@SECONDS, KIND one of " +
+            board::sim::fault_kind_names(board::sim::FaultKindList::Plain);
+    return false;
+  }
+  o.fault.at_s = at_s;
+  if (o.fault.kind == board::sim::FaultKind::CanBadFrames && o.transport != "can") {
+    error = "--inject can-bad-frames: the bad frames are CAN frames (--haptic-transport can)";
+    return false;
+  }
+  if (o.speed == 1.0) {
+    error = "--inject: faults are injected on the virtual clock (--fast or --speed N other than 1)";
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+void add_sim_options(CLI::App& app, SimOptions& options) {
+  add_operator_options(app, options);
+  add_record_options(app, options);
+  add_display_options(app, options.display);
+}
+
+bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
+  if (!check_display_options(o.display, error)) {
+    return false;
+  }
+  if ((o.fast || (o.speed > 0.0 && o.speed != 1.0)) &&
+      (app.count("--priority") + app.count("--cpu") + app.count("--require-rt")) > 0) {
+    error = "--priority, --cpu and --require-rt are for the real-time threads of --speed 1 only";
+    return false;
+  }
+  if (!o.inject_text.empty() && !check_inject(o, error)) {
+    return false;
+  }
+  if (!o.replay_path.empty()) {
+    if (!o.resume_path.empty() || !o.journal_path.empty() || !o.inject_text.empty() ||
+        app.count("--device-process") > 0 || o.speed == 1.0 || o.display.requested()) {
+      error = "--replay runs the recorded job on the virtual clock by itself: no --resume, --journal, --inject, "
+              "--device-process, --hmi or --speed 1 with it";
+      return false;
+    }
+    o.fast = o.fast || o.speed == 0.0;
+    o.no_journal = true;
+  }
+  if (!o.resume_path.empty() && (!o.journal_path.empty() || o.no_journal)) {
+    error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
+  } else if (o.no_journal && !o.journal_path.empty()) {
+    error = "--journal and --no-journal: choose one";
+  } else if (!o.device_log_path.empty() && (o.transport != "pio" || !o.inject_text.empty())) {
+    error = "--device-process: the device runs in its own process only with --haptic-transport pio and no --inject";
+  } else if (o.fast == (o.speed > 0.0)) {
+    error = o.fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)";
+  }
+  return error.empty();
+}
+
+}  // namespace stencil::app

@@ -1,0 +1,51 @@
+// stencil-sim's command line: every option with its help, and the checks of how they combine,
+// made before anything is read or opened.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "board/sim/fault_injection.hpp"
+#include "firmware/programs/display_option.hpp"
+
+namespace stencil::app {
+
+struct SimOptions {
+  std::string tables_path;    // empty: the baked-in hex prism
+  std::string operator_path;  // empty: the pattern
+  std::string pattern_name = "raster";
+  std::uint64_t seed = 1;
+  int moves = 200;
+  double duration_s = 0.0;
+  bool fast = false;
+  double speed = 0.0;         // 0: --fast; 1: real time; other: paced virtual time
+  int priority = 80;
+  int cpu = -1;
+  bool require_rt = false;
+  std::string report_path = "stencil-sim-report.json";
+  bool until_complete = false;
+  std::string stock_text;
+  std::string inject_text;
+  board::sim::FaultInjection fault;  // from inject_text, by check_sim_options
+  std::string journal_path;
+  bool no_journal = false;
+  std::string resume_path;
+  std::string replay_path;
+  std::string stock_csv_path;
+  std::string device_log_path;
+  std::string trace_path;
+  std::string transport = "direct";
+  DisplayOptions display;
+
+  [[nodiscard]] bool real_time() const { return !fast && speed == 1.0; }
+};
+
+void add_sim_options(CLI::App& app, SimOptions& options);
+
+// After parsing: how the options combine (and --inject read into `fault`; --replay implies --fast
+// unless paced, and no journal). False with the message for the terminal.
+[[nodiscard]] bool check_sim_options(const CLI::App& app, SimOptions& options, std::string& error);
+
+}  // namespace stencil::app
