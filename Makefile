@@ -94,8 +94,9 @@ fuzz: deps
 # A check for refactors: OLD's stencil-sim (built in a worktree under build/same-behaviour/old) and this
 # tree's run make demo's job and sim_cli.sh's cases on the virtual clock; their reports and journals
 # must be the same apart from the wall clock (toolchain/same-behaviour.sh).
-same-behaviour: build
+same-behaviour:
 	@test -n "$(OLD)" || { echo "usage: make same-behaviour OLD=<commit>" >&2; exit 2; }
+	@$(MAKE) --no-print-directory build
 	bash toolchain/same-behaviour.sh $(OLD) build
 
 # A check, not a test: README's two commands in a clean Debian 12 root made with mmdebstrap, the

@@ -33,10 +33,11 @@ enum class RecordType : std::uint8_t {
 // Payload of Start: u32 tables' CRC-32, u32 triangle count, i64 start (ns since the Unix epoch),
 // u16 program name length and its bytes, u16 job length and its bytes (what the program needs to
 // carry the same job on: a simulation's pattern and stock, for instance).
-// Payload of Cycle (86 bytes): u64 cycle, i64 time_ns, f64 device_mm[3], f64 angles_rad[2],
+// Payload of Cycle (106 bytes): u64 cycle, i64 time_ns, f64 device_mm[3], f64 angles_rad[2],
 // u32 sample_counter, u8 fresh, f64 virtual_tip_mm[3], u8 safe_reason, u32 touched_triangles,
 // f32 force_n[3], u16 status_bits, u8 read_status (hal::ReadStatus), u8 read_reason (hal::HapticFault).
 inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1 + 4 + 12 + 2 + 1 + 1;
+static_assert(kCyclePayloadBytes == 106, "the Cycle payload the comment above lays out");
 // Payload of SafeState: u64 cycle, u8 reason (control::SafeReason).
 inline constexpr std::uint32_t kSafeStatePayloadBytes = 9;
 // Payload of Homed: i64 time_ns (the machine's clock).
