@@ -15,7 +15,7 @@ help:
 	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
 	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
-	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime and boards <= 80 (not in CI yet)"
+	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
 	@echo "make fresh-check README's two commands in a clean Debian 12 root (mmdebstrap; needs root; about half an hour)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
@@ -76,9 +76,8 @@ soak-asan: deps
 	cmake --build --preset asan --target stencil-sim
 	bash toolchain/soak.sh build/asan/bin/stencil-sim build/soak-asan 0.5 4 $(SOAK_SEED)
 
-# A check, not yet in CI (issue 19's refactor brings the code under it): clang-tidy's
-# readability-function-size over the programs (main() at most 150 lines) and the runtime and boards
-# (80 lines a function), with the release configuration's compile_commands.json (toolchain/size-check.sh).
+# A check .ci/run makes after make test: clang-tidy's readability-function-size over the programs
+# (main() at most 150 lines) and the runtime, boards and programs' other files (80 lines a function), with the release configuration's compile_commands.json (toolchain/size-check.sh).
 .PHONY: size-check
 size-check: deps
 	cmake --preset release
