@@ -1,6 +1,6 @@
-// The host simulation's board: the controller's cycle and machine side wired to the simulated
-// device (in process), the fake CY545 on a pseudo-terminal, the simulated mill and its stock, and
-// the simulated operator; and the fast run loop that drives them on virtual time.
+// The host simulation's board: the simulated device (in process, over the PIO window or CAN), the fake
+// CY545 on a pseudo-terminal, the simulated mill and its stock, and the simulated operator, handed to
+// the runtime, which runs the job in virtual time (run_fast) or in real time (run_realtime).
 #pragma once
 
 #include <atomic>

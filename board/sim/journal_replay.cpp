@@ -1,0 +1,35 @@
+// A recorded run, cycle by cycle.
+#include "board/sim/journal_replay.hpp"
+
+#include "firmware/core/control/safe_state.hpp"
+
+namespace stencil::board::sim {
+
+bool JournalReplay::before_cycle(const runtime::CycleTime& /*time*/) {
+  if (cycles_ == records_.size()) {
+    return false;  // the record ends here, and so does the replay
+  }
+  recorded_ = &records_[cycles_];
+  device_.set(*recorded_);
+  // A safe state the device's read does not explain (the machine's fault, a stalled host, a stop):
+  // the record says it came, so it comes here too, at the same cycle.
+  if (recorded_->safe_reason != control::SafeReason::None && controller_.safe_reason() == control::SafeReason::None &&
+      !control::is_device_reason(recorded_->safe_reason)) {
+    static_cast<void>(commands_.push({control::CommandKind::Stop}));
+  }
+  return true;
+}
+
+void JournalReplay::after_cycle(const runtime::CycleTime& /*time*/, control::CycleStatus /*status*/) {
+  ++cycles_;
+  const Eigen::Vector3d tip = controller_.virtual_tip_mm();
+  if (tip.x() != recorded_->virtual_tip_mm[0] || tip.y() != recorded_->virtual_tip_mm[1] ||
+      tip.z() != recorded_->virtual_tip_mm[2]) {
+    if (mismatches_++ == 0) {
+      first_mismatch_ = static_cast<std::int64_t>(recorded_->cycle);
+    }
+  }
+  recorded_reason_ = recorded_->safe_reason;
+}
+
+}  // namespace stencil::board::sim

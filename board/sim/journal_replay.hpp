@@ -1,0 +1,47 @@
+// JournalReplay: one recorded run of a journal replayed (stencil-sim --replay): before each cycle the
+// device gives exactly what the recorded cycle read, and after it the virtual tool is compared with
+// the recorded one, bit for bit. The run ends with the records. A hook of the job's run, virtual
+// time only.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/control/cycle_messages.hpp"
+#include "firmware/runtime/job_hooks.hpp"
+#include "sim/haptic_device/replay_haptic_device.hpp"
+
+namespace stencil::board::sim {
+
+class JournalReplay final : public runtime::JobHooks {
+ public:
+  // Everything must outlive the replay; `device` is what the cycle reads, `commands` its command
+  // ring (this hook pushes on the cycle's thread, which in virtual time is the ring's one producer).
+  JournalReplay(const std::vector<control::JournalRecord>& records, stencil::sim::ReplayHapticDevice& device,
+                const control::Controller& controller, control::CommandRing& commands)
+      : records_(records), device_(device), controller_(controller), commands_(commands) {}
+
+  bool before_cycle(const runtime::CycleTime& time) override;
+  void after_cycle(const runtime::CycleTime& time, control::CycleStatus status) override;
+
+  // Cycles compared, those whose virtual tool differs, the first of them (-1: none), and the safe
+  // state the record ended in.
+  [[nodiscard]] std::uint64_t cycles() const { return cycles_; }
+  [[nodiscard]] std::uint64_t mismatches() const { return mismatches_; }
+  [[nodiscard]] std::int64_t first_mismatch() const { return first_mismatch_; }
+  [[nodiscard]] control::SafeReason recorded_reason() const { return recorded_reason_; }
+
+ private:
+  const std::vector<control::JournalRecord>& records_;
+  stencil::sim::ReplayHapticDevice& device_;
+  const control::Controller& controller_;
+  control::CommandRing& commands_;
+  const control::JournalRecord* recorded_ = nullptr;  // this cycle's
+  std::uint64_t cycles_ = 0;
+  std::uint64_t mismatches_ = 0;
+  std::int64_t first_mismatch_ = -1;
+  control::SafeReason recorded_reason_ = control::SafeReason::None;
+};
+
+}  // namespace stencil::board::sim

@@ -1,0 +1,21 @@
+// The cycle's configuration from a board's facts: its frames, its device's reach and the speed its
+// mill follows. A board sets what is its own on top (a held start, its watchdogs' limits).
+#pragma once
+
+#include <Eigen/Core>
+
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/motion/machine_frames.hpp"
+
+namespace stencil::runtime {
+
+struct CycleFacts {
+  motion::MachineFrames frames;           // device -> world -> machine
+  Eigen::Vector3d device_workspace_mm;    // the device's workspace, from its corner origin
+  double virtual_tool_speed_mm_per_s;     // what the mill follows, per axis and |dx| + |dy| + |dz|
+  bool count_overruns;                    // in real time; in virtual time lateness means nothing
+};
+
+[[nodiscard]] control::ControllerConfig controller_config(const CycleFacts& facts);
+
+}  // namespace stencil::runtime
