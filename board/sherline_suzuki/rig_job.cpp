@@ -9,7 +9,7 @@
 #include <thread>
 #include <vector>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/control/loop_statistics.hpp"
 #include "firmware/core/control/machine_side.hpp"
@@ -18,28 +18,31 @@
 namespace stencil::board::sherline_suzuki {
 namespace {
 
-constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
-constexpr auto kUpdateNs = static_cast<hal::MonotonicNs>(1e9 / kRig.machine_update_hz);
-constexpr double kModelCellMm = 0.05;
-// The virtual tool is held to what the mill follows over the serial line (as in the simulation,
-// which mirrors the rig): 1 mm/s per axis and in |dx| + |dy| + |dz|.
-constexpr double kVirtualToolSpeedMmPerS = 1.0;
+// kPeriodNs and kUpdateNs: rig_facts.hpp.
+constexpr double kModelCellMm = kRig.stock_model_cell_mm;
+constexpr double kVirtualToolSpeedMmPerS = kRig.virtual_tool_speed_mm_per_s;
 
 }  // namespace
 
 motion::MachineFrames rig_frames(const WorkOffset& offset) {
   Eigen::Vector3d home = offset.home_world_mm;
   home.z() -= offset.tool_stick_out_mm - offset.reference_stick_out_mm;
-  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, {-1, -1, -1}, kRig.steps_per_mm};
+  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, kRig.machine_sign, kRig.steps_per_mm};
 }
 
 control::ControllerConfig rig_controller_config(const RigJob& job) {
   const motion::MachineFrames frames = rig_frames(job.offset);
   control::ControllerConfig config;
   config.frames = frames;
-  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
-  config.device_high_mm = Eigen::Vector3d(kRig.haptic_workspace_mm[0] + 25.0, kRig.haptic_workspace_mm[1] + 25.0,
-                                          kRig.haptic_workspace_mm[2] + 25.0);
+  config.contact.device_mm_per_world_mm = kRig.haptic_to_machine_scale;
+  config.haptic.device_mm_per_world_mm = kRig.haptic_to_machine_scale;
+  config.haptic.max_force_n = kRig.force_limit_n;
+  config.haptic.max_torque_nmm = kRig.torque_limit_nmm;
+  config.period_s = 1.0 / kRig.haptic_rate_hz;
+  config.device_low_mm = Eigen::Vector3d::Constant(-kRig.device_reach_margin_mm);
+  config.device_high_mm = Eigen::Vector3d(kRig.haptic_workspace_mm[0] + kRig.device_reach_margin_mm,
+                                          kRig.haptic_workspace_mm[1] + kRig.device_reach_margin_mm,
+                                          kRig.haptic_workspace_mm[2] + kRig.device_reach_margin_mm);
   config.home_tip_mm = frames.home_world_mm;
   config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.count_overruns = true;
@@ -67,10 +70,7 @@ RigResult run_rig(const RigJob& job, const runtime::PeriodicRunner& runner) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
   }
-  const motion::PlannerLimits limits{{kRig.max_speed_mm_per_s, 1000.0, kRig.steps_per_mm},
-                                     1.0 / kRig.machine_update_hz,
-                                     {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
-                                      static_cast<std::int32_t>(backlash_steps(2))}};
+  const motion::PlannerLimits limits = kPlannerLimits;
   auto machine = std::make_unique<control::MachineSide>(part, *job.machine, frames, limits, rings->machine, rings->machine_events);
   std::vector<float> model_cells(control::CommandedStock::cells_needed(job.stock, kModelCellMm));
   control::CommandedStock model(job.stock, kModelCellMm, part.tool.spec, model_cells);

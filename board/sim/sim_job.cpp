@@ -48,18 +48,12 @@
 namespace stencil::board::sim {
 namespace {
 
-constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
-constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
+// kPeriodNs, kUpdateNs, kWatchdogRelayNs, kBaud, kModelCellMm: sim_facts.hpp (the rig's).
 // An update's bound from its actual start: a move of one period's steps plus the CY545's commands,
 // each with its settle (up to about 40 ms for three axes that change channel), fits in three periods;
 // an update that takes longer than a period only makes the mill fall behind (the backlog slows the
 // virtual tool), never a fault.
 constexpr hal::MonotonicNs kUpdateBoundNs = 3 * kUpdateNs;
-// The simulated rig's hardware watchdog relay: it opens when the heartbeat output has not changed
-// for this long (the driver toggles it every 200 ms).
-constexpr hal::MonotonicNs kWatchdogRelayNs = 1'000'000'000;
-constexpr double kBaud = 57600.0;
-constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
 
 
 Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
@@ -83,7 +77,7 @@ double reachable_coverage(const tables::PartTables& part, const engine::Triangle
 class SimulatedDeviceWiring {
  public:
   SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand, std::string& error)
-      : transport_(transport), direct_(hal::kCornerOriginHapticRange) {
+      : transport_(transport), direct_(kDeviceRange) {
     const auto pose = [&hand, this](std::uint32_t, hal::MonotonicNs) {
       const Eigen::Vector3d at = disturbed(hand.handle_mm);
       return stencil::sim::SimulatedPose{{at.x(), at.y(), at.z()}, {0.0, 0.0}};
@@ -94,7 +88,7 @@ class SimulatedDeviceWiring {
         return;
       }
       device_link_ = std::make_unique<stencil::sim::PioDeviceLink>(window_->window());
-      pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), hal::kCornerOriginHapticRange);
+      pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), kDeviceRange);
       host_ = pio_host_.get();
     } else if (transport == HapticTransport::Can) {
       int fds[2] = {-1, -1};
@@ -107,7 +101,7 @@ class SimulatedDeviceWiring {
       auto can_link = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
       can_device_link_ = can_link.get();
       device_link_ = std::move(can_link);
-      can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), hal::kCornerOriginHapticRange);
+      can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), kDeviceRange);
       host_ = can_host_.get();
     }
     if (device_link_ != nullptr) {
@@ -211,7 +205,7 @@ class SimulatedDeviceWiring {
 motion::MachineFrames frames() {
   // Every axis counts into the workspace from its switch, so the world runs against all three.
   return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
-          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), {-1, -1, -1}, 640.0};
+          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), rig::kRig.machine_sign, rig::kRig.steps_per_mm};
 }
 
 stencil::sim::StockBox default_stock(const tables::PartTables& part) {
@@ -233,8 +227,15 @@ control::ControllerConfig controller_config(bool realtime) {
   const motion::MachineFrames frames = sim::frames();
   control::ControllerConfig config;
   config.frames = frames;
-  config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
-  config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
+  config.contact.device_mm_per_world_mm = kDeviceMmPerWorldMm;
+  config.haptic.device_mm_per_world_mm = kDeviceMmPerWorldMm;
+  config.haptic.max_force_n = rig::kRig.force_limit_n;
+  config.haptic.max_torque_nmm = rig::kRig.torque_limit_nmm;
+  config.period_s = 1.0 / rig::kRig.haptic_rate_hz;
+  config.device_low_mm = Eigen::Vector3d::Constant(-rig::kRig.device_reach_margin_mm);
+  config.device_high_mm = Eigen::Vector3d(rig::kRig.haptic_workspace_mm[0] + rig::kRig.device_reach_margin_mm,
+                                          rig::kRig.haptic_workspace_mm[1] + rig::kRig.device_reach_margin_mm,
+                                          rig::kRig.haptic_workspace_mm[2] + rig::kRig.device_reach_margin_mm);
   config.home_tip_mm = frames.home_world_mm;
   config.count_overruns = realtime;  // on virtual time lateness means nothing
   config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
@@ -371,9 +372,9 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   const motion::MachineFrames frames = sim::frames();
 
   // The far side of the serial cable: the mill, its fake CY545 on a pty, the clock they follow.
-  stencil::sim::SimulatedMill mill{stencil::sim::sherline_mill_config()};
+  stencil::sim::SimulatedMill mill{kMillConfig};
   const hal::MonotonicNs epoch_ns = realtime ? hal::posix_clock::monotonic_now_ns() : 0;
-  stencil::sim::cy545::FakeCy545 fake{mill, epoch_ns};
+  stencil::sim::cy545::FakeCy545 fake{mill, kMmc4sWiring, epoch_ns};
   // Virtual time only: it gives the fake's bytes their wire time and its commands the chip's time,
   // which in real time the fake cannot know (a pty merges the driver's writes).
   std::optional<stencil::sim::cy545::FakeCy545Clock> fast_clock;
@@ -384,8 +385,8 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   hal::Clock& machine_clock = realtime ? static_cast<hal::Clock&>(wall_clock) : *fast_clock;
   fake.board().set_channel_latching(stencil::sim::cy545::ChannelLatching::Address);
   fake.chip().set_command_time_ns(0);  // see link_config.command_settle_ns
-  // The rig's hardware watchdog relay on the heartbeat output (Cy545Config::heartbeat_output).
-  fake.board().arm_watchdog_relay(5, kWatchdogRelayNs, epoch_ns);
+  // The rig's hardware watchdog relay on the heartbeat output (Mmc4sWiring::heartbeat_output).
+  fake.board().arm_watchdog_relay(kMmc4sWiring.heartbeat_output, kWatchdogRelayNs, epoch_ns);
   stencil::sim::MachinedPart machined{part, job.stock, frames, [&fake, epoch_ns] {
                                         return static_cast<double>(fake.chip().now_ns() - epoch_ns) / 1e9;
                                       }};
@@ -399,21 +400,7 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
     result.error = std::string("the fake CY545's pty: ") + port_error;
     return result;
   }
-  hal::cy545::Cy545Config link_config;
-  link_config.homing_rate = 20000;
-  link_config.homing_slow_rate = 2000;
-  // The simulated rig takes the thesis's reading of the MMC-4S (an address latch: one select a change
-  // of axis): the per-line reading's extra commands cost the mill much of its throughput (the demo
-  // job: 0.93 % -> 5.4 % uncut). The driver is held to the per-line board by its own tests.
-  link_config.channel_lines_latch_data = false;
-  // Nor does it take the chip's per-command time (an assumption of 1 ms, unmeasured) and the driver's
-  // settle against it: measured on the demo job they cost 0.93 % -> 1.72 % of the stock left uncut.
-  // hal_cy545_tests hold the driver's pacing to that chip on virtual time; the rig keeps its settle.
-  link_config.command_settle_ns = 0;
-  if (realtime) {
-    // The fake answers from a thread on a host that is not real-time: a late reply is its scheduling.
-    link_config.reply_timeout_ns = 250'000'000;
-  }
+  const hal::cy545::Cy545Config link_config = sim::link_config(realtime);  // the rig's, but (sim_facts.hpp)
   hal::cy545::Cy545Link link(port, machine_clock, link_config);
 
   auto rings = std::make_unique<control::CycleRingStorage>();
@@ -452,7 +439,7 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
     result.error = "the tables' tool could not be grown for the touched set";
     return result;
   }
-  const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
+  const motion::PlannerLimits limits = kPlannerLimits;
   auto machine = std::make_unique<control::MachineSide>(part, link, frames, limits, rings->machine, rings->machine_events);
   // At the end, once the machine side has stopped the mill: its power as the board's latches leave
   // it, then a second later, when the watchdog relay (armed above) has dropped what the driver could

@@ -22,7 +22,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
@@ -161,7 +161,10 @@ int main(int argc, char** argv) {
   app.add_option("--priority", priority, "the cycle thread's SCHED_FIFO priority")->check(CLI::Range(1, 99))->capture_default_str();
   int cpu = -1;
   app.add_option("--cpu", cpu, "pin the cycle thread to this CPU (the other threads keep off it)")->check(CLI::NonNegativeNumber);
-  std::string offset_text = "50,25,25";
+  namespace rig = board::sherline_suzuki;
+  char home_text[64];
+  std::snprintf(home_text, sizeof home_text, "%g,%g,%g", rig::kHomeWorldMm[0], rig::kHomeWorldMm[1], rig::kHomeWorldMm[2]);
+  std::string offset_text = home_text;  // the machine's home before any touch-off
   app.add_option("--work-offset", offset_text,
                  "X,Y,Z: where the tool tip is in the part's coordinates (mm) with the machine at home, from the touch-off")
       ->capture_default_str();
@@ -219,19 +222,20 @@ int main(int argc, char** argv) {
   offset.home_world_mm = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
   offset.tool_stick_out_mm = stick_out;
   offset.reference_stick_out_mm = reference_stick_out;
-  control::StockBlock stock{{0.0, 0.0, 0.0},
-                            {board::sherline_suzuki::kRig.workspace_mm[0], board::sherline_suzuki::kRig.workspace_mm[1],
-                             board::sherline_suzuki::kRig.workspace_mm[2]}};
+  control::StockBlock stock{{0.0, 0.0, 0.0}, {rig::kRig.workspace_mm[0], rig::kRig.workspace_mm[1], rig::kRig.workspace_mm[2]}};
   if (!stock_text.empty()) {
     bool inside = parse_numbers(stock_text, numbers, 6);
     for (int axis = 0; inside && axis < 3; ++axis) {
       const auto a = static_cast<std::size_t>(axis);
-      inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= board::sherline_suzuki::kRig.workspace_mm[a];
+      inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= rig::kRig.workspace_mm[a];
     }
     if (!inside) {
+      char workspace_text[96];
+      std::snprintf(workspace_text, sizeof workspace_text, "[0,%g]x[0,%g]x[0,%g]", rig::kRig.workspace_mm[0],
+                    rig::kRig.workspace_mm[1], rig::kRig.workspace_mm[2]);
       return fail(kExitBadInput, "--stock " + stock_text +
-                                     ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace "
-                                     "[0,50]x[0,25]x[0,25]");
+                                     ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace " +
+                                     workspace_text);
     }
     stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
   }
@@ -291,7 +295,7 @@ int main(int argc, char** argv) {
     if (window == nullptr) {
       return fail(kExitNotStarted, "the haptic device's PIO window: " + error);
     }
-    pio_device = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
+    pio_device = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), board::sherline_suzuki::kDeviceRange);
     device = pio_device.get();
   } else {
     const std::string interface = haptic.substr(4);
@@ -307,7 +311,7 @@ int main(int argc, char** argv) {
       return fail(kExitNotStarted, "the haptic device's CAN link: " + error);
     }
     std::printf("stencil-rig: %s\n", bitrate_note.c_str());
-    can_device = std::make_unique<hal::socketcan::SocketCanHapticDevice>(channel.get(), hal::kCornerOriginHapticRange);
+    can_device = std::make_unique<hal::socketcan::SocketCanHapticDevice>(channel.get(), board::sherline_suzuki::kDeviceRange);
     device = can_device.get();
   }
 
@@ -368,7 +372,7 @@ int main(int argc, char** argv) {
   }
 
   hal::posix_clock::MonotonicClock clock;
-  hal::cy545::Cy545Config link_config;
+  const hal::cy545::Cy545Config link_config = rig::kCy545;
   hal::cy545::Cy545Link link(port, clock, link_config);
   // Every signal that ends a session ends the job through the cycle's stop (spindle and drivers off):
   // a closed terminal (SIGHUP) or Ctrl-\ (SIGQUIT) as much as Ctrl-C. Nothing survives SIGKILL or a
