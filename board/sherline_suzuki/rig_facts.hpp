@@ -27,7 +27,7 @@ struct RigFacts {
   double step_rate_steps_per_s;             // the CY545's R and F: all axes together, one at a time
   std::array<double, 3> backlash_mm;
   double machine_update_hz;                 // the CY545 link's updates
-  double serial_baud;                       // RS-232 8N1, CTS handshake
+  std::uint32_t serial_baud;                // the CY545's RS-232 line, 8N1
   // How far each axis can travel past the workspace: below 0 is the home switch's closed zone down to
   // the low hard stop, above the workspace a margin up to the high hard stop.
   double home_overtravel_mm;
@@ -74,7 +74,7 @@ inline constexpr RigFacts kRig{
     .step_rate_steps_per_s = 1000.0,
     .backlash_mm = {0.125, 0.05, 0.125},
     .machine_update_hz = 30.0,
-    .serial_baud = 57600.0,
+    .serial_baud = 57600,
     .home_overtravel_mm = 3.0,
     .far_overtravel_mm = 5.0,
     .home_switch_edge_mm = 0.0,

@@ -38,8 +38,9 @@ inline constexpr double kOperatorSpeedMmPerS = 0.8 * kVirtualToolSpeedMmPerS;
 // The controller's model of the machined stock: the rig's cells, as fine as the simulated mill's Z-map.
 inline constexpr double kModelCellMm = rig::kRig.stock_model_cell_mm;
 
-// The serial line's bytes take their wire time at the rig's baud rate (the fake's virtual clock).
-inline constexpr double kBaud = rig::kRig.serial_baud;
+// The serial line: the rig's baud rate (the port opens at it; on virtual time the fake's bytes take
+// their wire time at it).
+inline constexpr std::uint32_t kBaud = rig::kRig.serial_baud;
 
 // The simulated rig's hardware watchdog relay: the rig's, on the rig's heartbeat output.
 inline constexpr hal::MonotonicNs kWatchdogRelayNs = rig::kRig.watchdog_relay_timeout_ns;

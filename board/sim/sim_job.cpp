@@ -396,7 +396,7 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   // The controller's side: the driver, the rings, the cycle and the machine side.
   hal::cy545::SerialPort port;
   char port_error[256] = {};
-  if (!port.open(fake.slave_path().c_str(), port_error)) {
+  if (!port.open(fake.slave_path().c_str(), kBaud, port_error)) {
     result.error = std::string("the fake CY545's pty: ") + port_error;
     return result;
   }

@@ -280,7 +280,7 @@ int main(int argc, char** argv) {
 
   hal::cy545::SerialPort port;
   char port_error[256] = {};
-  if (!port.open(serial_path.c_str(), port_error)) {
+  if (!port.open(serial_path.c_str(), rig::kRig.serial_baud, port_error)) {
     return fail(kExitNotStarted, std::string("the mill's CY545: ") + port_error);
   }
   std::string error;

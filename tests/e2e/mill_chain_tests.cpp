@@ -59,7 +59,7 @@ TEST(MillChain, TheMillFollowsTheVirtualToolRoundTheHexPrismThroughTheRealDriver
   hal::posix_clock::MonotonicClock clock;
   hal::cy545::SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(fake.slave_path().c_str(), error), error);
+  CHECK_TEXT(port.open(fake.slave_path().c_str(), rig::kRig.serial_baud, error), error);
   hal::cy545::Cy545Config config = rig::kCy545;
   config.motion.homing_rate = 20000;
   config.motion.homing_slow_rate = 5000;

@@ -67,7 +67,7 @@ struct FakeRig {
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
     fake_runner = std::make_unique<sim::cy545::FakeCy545Runner>(fake);
     char port_error[256] = {};
-    CHECK_TRUE(port.open(fake.slave_path().c_str(), port_error));
+    CHECK_TRUE(port.open(fake.slave_path().c_str(), rig::kRig.serial_baud, port_error));
     hal::cy545::Cy545Config config = rig::kCy545;
     config.motion.homing_rate = 20000;  // the fake homes in a fraction of a second
     config.motion.homing_slow_rate = 5000;

@@ -35,6 +35,7 @@ using stencil::sim::StepDirection;
 namespace {
 
 constexpr MonotonicNs kMs = 1'000'000;
+constexpr std::uint32_t kBaud = stencil::board::sim::kBaud;  // the rig's line, as the simulation runs it
 
 Cy545Config fast_homing_config() {
   Cy545Config config = stencil::board::sherline_suzuki::kCy545;
@@ -69,7 +70,7 @@ struct Bench {
   }
   static bool open(SerialPort& port, const std::string& path) {
     char error[256] = {};
-    CHECK_TEXT(port.open(path.c_str(), error), error);
+    CHECK_TEXT(port.open(path.c_str(), kBaud, error), error);
     return true;
   }
   MonotonicNs in(MonotonicNs ns) const { return clock.now_ns() + ns; }
@@ -220,16 +221,16 @@ TEST(Cy545Link, StartUpGivesUpWhenTheControllerNeverAnswers) {
 TEST(Cy545Link, APathThatIsNotASerialPortIsRefusedByName) {
   SerialPort port;
   char error[256] = {};
-  CHECK_FALSE(port.open("/dev/null", error));
+  CHECK_FALSE(port.open("/dev/null", kBaud, error));
   STRCMP_CONTAINS("/dev/null: not a serial port", error);
   char file[] = "/tmp/stencil-not-a-tty-XXXXXX";
   const int fd = mkstemp(file);
   CHECK(fd >= 0);
   close(fd);
-  CHECK_FALSE(port.open(file, error));
+  CHECK_FALSE(port.open(file, kBaud, error));
   STRCMP_CONTAINS("not a serial port", error);
   unlink(file);
-  CHECK_FALSE(port.open("/dev/no-such-port", error));
+  CHECK_FALSE(port.open("/dev/no-such-port", kBaud, error));
   STRCMP_CONTAINS("/dev/no-such-port: cannot open", error);
 }
 
@@ -241,7 +242,7 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
   CHECK(grantpt(master) == 0 && unlockpt(master) == 0);
   SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(ptsname(master), error), error);
+  CHECK_TEXT(port.open(ptsname(master), kBaud, error), error);
   CHECK_FALSE(port.has_modem_lines());
   posix_clock::MonotonicClock clock;
   Cy545Link link(port, clock, stencil::board::sherline_suzuki::kCy545);
@@ -410,7 +411,7 @@ namespace {
 struct VirtualBench {
   sim::SimulatedMill mill{stencil::board::sim::kMillConfig};  // every axis mid-travel, as at power-up
   sim::cy545::FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, 0};
-  sim::cy545::FakeCy545Clock clock{fake, 0, 57600.0};
+  sim::cy545::FakeCy545Clock clock{fake, 0, kBaud};
   SerialPort port;
   bool opened = Bench::open(port, fake.slave_path());
   Cy545Link link;
