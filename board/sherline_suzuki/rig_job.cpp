@@ -48,8 +48,8 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
   config.count_overruns = true;
   config.overrun_limit = job.overrun_limit;
   config.stale_periods = job.stale_periods;
-  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
-  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * config.period_s;
+  config.max_total_move_mm = kVirtualToolSpeedMmPerS * config.period_s;
   return config;
 }
 

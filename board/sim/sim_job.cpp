@@ -238,8 +238,8 @@ control::ControllerConfig controller_config(bool realtime) {
                                           rig::kRig.haptic_workspace_mm[2] + rig::kRig.device_reach_margin_mm);
   config.home_tip_mm = frames.home_world_mm;
   config.count_overruns = realtime;  // on virtual time lateness means nothing
-  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
-  config.max_total_move_mm = kVirtualToolSpeedMmPerS * 1e-3;
+  config.max_axis_move_mm = kVirtualToolSpeedMmPerS * config.period_s;
+  config.max_total_move_mm = kVirtualToolSpeedMmPerS * config.period_s;
   return config;
 }
 
