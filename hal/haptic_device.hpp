@@ -34,22 +34,15 @@ struct HapticCommand {
 };
 
 // What the backend accepts: positions and angles beyond these are refused, forces and torques are
-// clamped to them (in magnitude) before they leave the host.
+// clamped to them (in magnitude) before they leave the host. Each board passes its device's (the
+// Sherline rig's: board/sherline_suzuki/rig_facts.hpp).
 struct HapticRange {
   double position_limit_mm[3];   // |position - centre| per axis: half the reach plus a margin
   double angle_limit_rad;        // |angle|, both angles
-  double force_limit_n;          // the board's force limit (5 N on the rig)
+  double force_limit_n;          // the board's force limit
   double torque_limit_nmm;       // magnitude of the two-component torque
   double position_centre_mm[3];  // the middle of the reach in device coordinates
 };
-
-// The reach of the rig's device (500 x 250 x 250 mm, centred on the origin) with a 25 mm margin per
-// side, its 5 N board limit and the engine's torque limit. A board may pass its own.
-inline constexpr HapticRange kDefaultHapticRange{{275.0, 150.0, 150.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}};
-
-// The same reach with the device's origin at a corner: device space [0, 500] x [0, 250] x [0, 250],
-// the frame of the controller's programs (world = device / 10).
-inline constexpr HapticRange kCornerOriginHapticRange{{275.0, 150.0, 150.0}, 3.2, 5.0, 200.0, {250.0, 125.0, 125.0}};
 
 enum class ReadStatus : std::uint8_t {
   Fresh,     // a new sample (its counter moved) was accepted into `out`

@@ -1,5 +1,7 @@
 #include "board/sherline_suzuki/rig_devices.hpp"
 
+#include "board/sherline_suzuki/rig_facts.hpp"
+
 #include "hal/socketcan/can_frame_layout.hpp"
 #include "hal/socketcan/can_interface_bitrate.hpp"
 
@@ -13,7 +15,7 @@ bool open_pio(const std::string& path, RigDevices& devices, std::string& error) 
     return false;
   }
   devices.pio_device =
-      std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&devices.window->window(), hal::kCornerOriginHapticRange);
+      std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&devices.window->window(), kDeviceRange);
   devices.device = devices.pio_device.get();
   return true;
 }
@@ -35,7 +37,7 @@ bool open_can(const std::string& interface, RigDevices& devices, const std::func
   }
   note(bitrate_note);
   devices.can_device =
-      std::make_unique<hal::socketcan::SocketCanHapticDevice>(devices.channel.get(), hal::kCornerOriginHapticRange);
+      std::make_unique<hal::socketcan::SocketCanHapticDevice>(devices.channel.get(), kDeviceRange);
   devices.device = devices.can_device.get();
   return true;
 }
@@ -49,7 +51,7 @@ bool is_haptic_link_name(const std::string& haptic) {
 bool open_rig_devices(const std::string& serial_path, const std::string& haptic, RigDevices& devices,
                       const std::function<void(const std::string&)>& note, std::string& error) {
   char port_error[256] = {};
-  if (!devices.port.open(serial_path.c_str(), port_error)) {
+  if (!devices.port.open(serial_path.c_str(), kRig.serial_baud, port_error)) {
     error = std::string("the mill's CY545: ") + port_error;
     return false;
   }
@@ -58,7 +60,7 @@ bool open_rig_devices(const std::string& serial_path, const std::string& haptic,
   if (!opened) {
     return false;
   }
-  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, hal::cy545::Cy545Config{});
+  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, kCy545);
   return true;
 }
 

@@ -6,7 +6,7 @@
 #include <algorithm>
 
 #include "board/sherline_suzuki/operator_terminal.hpp"
-#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/runtime/cycle_config.hpp"
 #include "firmware/runtime/job.hpp"
 #include "firmware/runtime/threaded_run.hpp"
@@ -14,12 +14,9 @@
 namespace stencil::board::sherline_suzuki {
 namespace {
 
-constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
-constexpr auto kUpdateNs = static_cast<hal::MonotonicNs>(1e9 / kRig.machine_update_hz);
-constexpr double kModelCellMm = 0.05;
-// The virtual tool is held to what the mill follows over the serial line (as in the simulation,
-// which mirrors the rig): 1 mm/s per axis and in |dx| + |dy| + |dz|.
-constexpr double kVirtualToolSpeedMmPerS = 1.0;
+// kPeriodNs and kUpdateNs: rig_facts.hpp.
+constexpr double kModelCellMm = kRig.stock_model_cell_mm;
+constexpr double kVirtualToolSpeedMmPerS = kRig.virtual_tool_speed_mm_per_s;
 
 runtime::JobParts parts_of(const RigJob& job) {
   runtime::JobParts parts;
@@ -28,10 +25,7 @@ runtime::JobParts parts_of(const RigJob& job) {
   parts.machine = job.machine;
   parts.machine_clock = job.machine_clock;
   parts.controller = rig_controller_config(job);
-  parts.planner = {{kRig.max_speed_mm_per_s, 1000.0, kRig.steps_per_mm},
-                   1.0 / kRig.machine_update_hz,
-                   {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
-                    static_cast<std::int32_t>(backlash_steps(2))}};
+  parts.planner = kPlannerLimits;
   parts.period_ns = kPeriodNs;
   parts.update_ns = kUpdateNs;
   parts.shut_down_bound_ns = 2 * kUpdateNs;
@@ -79,14 +73,15 @@ void fill_result(RigResult& result, const runtime::Job& assembled, const runtime
 motion::MachineFrames rig_frames(const WorkOffset& offset) {
   Eigen::Vector3d home = offset.home_world_mm;
   home.z() -= offset.tool_stick_out_mm - offset.reference_stick_out_mm;
-  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, {-1, -1, -1}, kRig.steps_per_mm};
+  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, kRig.machine_sign, kRig.steps_per_mm};
 }
 
 control::ControllerConfig rig_controller_config(const RigJob& job) {
   const Eigen::Vector3d device_workspace_mm(kRig.haptic_workspace_mm[0], kRig.haptic_workspace_mm[1],
                                             kRig.haptic_workspace_mm[2]);
-  control::ControllerConfig config =
-      runtime::controller_config({rig_frames(job.offset), device_workspace_mm, kVirtualToolSpeedMmPerS, true});
+  control::ControllerConfig config = runtime::controller_config(
+      {rig_frames(job.offset), device_workspace_mm, kRig.device_reach_margin_mm, kRig.force_limit_n,
+       kRig.torque_limit_nmm, 1.0 / kRig.haptic_rate_hz, kVirtualToolSpeedMmPerS, true});
   config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.overrun_limit = job.overrun_limit;
   config.stale_periods = job.stale_periods;

@@ -11,6 +11,7 @@
 
 #include <Eigen/Core>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/control/commanded_stock.hpp"
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/control/display_feed.hpp"
@@ -29,7 +30,7 @@ namespace stencil::board::sherline_suzuki {
 // Where the tool tip is in the world (the part's coordinates) when the machine is at home, from the
 // touch-off, and the tool's stick-out below the holder against the one the touch-off was made with.
 struct WorkOffset {
-  Eigen::Vector3d home_world_mm{50.0, 25.0, 25.0};  // the tip at home: the workspace's far top corner
+  Eigen::Vector3d home_world_mm{kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]};  // the workspace's far top corner
   double tool_stick_out_mm = 0.0;                   // 0: the touch-off's own tool
   double reference_stick_out_mm = 0.0;
 };
@@ -55,13 +56,13 @@ struct RigJob {
   double duration_s = 0.0;                          // 0: until interrupted or a safe state
   // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
   // hosts they run on are not real-time hosts (make latency measures what a host gives).
-  int overrun_limit = 3;
+  int overrun_limit = kRig.overrun_limit;
   // The cycle starts held (no tool motion, no force) until the hand is held still near the tool, as
   // for a reset: on the rig always; the tests' scripted hands, which move from the start, turn it off.
-  bool start_held = true;
+  bool start_held = kRig.start_held;
   // More periods than this without a fresh device sample is a safe state: 5 on the rig (the tests
   // raise it for the same reason: their simulated device is a thread on a host that stalls).
-  int stale_periods = 5;
+  int stale_periods = kRig.stale_periods;
   std::function<void(const std::string&)> progress;  // a line about every second, and every event
   // Once homed, before the spindle starts: blocks until the operator confirms (true) or the job is
   // to end (false: the mill stays homed with the spindle off and the run ends). Null: no confirmation.

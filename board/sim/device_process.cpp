@@ -12,12 +12,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "board/sim/sim_facts.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
 
 namespace stencil::board::sim {
 namespace {
 
-constexpr std::int64_t kPeriodNs = 1'000'000;
+// kPeriodNs: sim_facts.hpp (the rig's device samples at the cycle's rate).
 
 // The wall clock the device keeps once on its own: CLOCK_MONOTONIC, as the cycle's.
 using hal::posix_clock::monotonic_now_ns;

@@ -1,39 +1,13 @@
 // The simulated machine's far side and the driver's end, set up as the rig's are.
 #include "board/sim/mill_wiring.hpp"
 
+#include "board/sim/sim_facts.hpp"
+
 namespace stencil::board::sim {
-namespace {
-
-// The simulated rig's hardware watchdog relay: it opens when the heartbeat output has not changed
-// for this long (the driver toggles it every 200 ms).
-constexpr hal::MonotonicNs kWatchdogRelayNs = 1'000'000'000;
-constexpr double kBaud = 57600.0;
-
-hal::cy545::Cy545Config link_config(bool realtime) {
-  hal::cy545::Cy545Config config;
-  config.homing_rate = 20000;
-  config.homing_slow_rate = 2000;
-  // The simulated rig takes the thesis's reading of the MMC-4S (an address latch: one select a change
-  // of axis): the per-line reading's extra commands cost the mill much of its throughput (the demo
-  // job: 0.93 % -> 5.4 % uncut). The driver is held to the per-line board by its own tests.
-  config.channel_lines_latch_data = false;
-  // Nor does it take the chip's per-command time (an assumption of 1 ms, unmeasured) and the driver's
-  // settle against it: measured on the demo job they cost 0.93 % -> 1.72 % of the stock left uncut.
-  // hal_cy545_tests hold the driver's pacing to that chip on virtual time; the rig keeps its settle.
-  config.command_settle_ns = 0;
-  if (realtime) {
-    // The fake answers from a thread on a host that is not real-time: a late reply is its scheduling.
-    config.reply_timeout_ns = 250'000'000;
-  }
-  return config;
-}
-
-}  // namespace
-
 MillWiring::MillWiring(const SimJob& job, bool realtime)
-    : mill_{stencil::sim::sherline_mill_config()},
+    : mill_{kMillConfig},
       epoch_ns_(realtime ? hal::posix_clock::monotonic_now_ns() : 0),
-      fake_{mill_, epoch_ns_},
+      fake_{mill_, kMmc4sWiring, epoch_ns_},
       machined_{*job.part, job.stock, frames(),
                 [this] { return static_cast<double>(fake_.chip().now_ns() - epoch_ns_) / 1e9; }} {
   // Virtual time only: it gives the fake's bytes their wire time and its commands the chip's time,
@@ -43,16 +17,16 @@ MillWiring::MillWiring(const SimJob& job, bool realtime)
   }
   fake_.board().set_channel_latching(stencil::sim::cy545::ChannelLatching::Address);
   fake_.chip().set_command_time_ns(0);  // see link_config's command_settle_ns
-  // The rig's hardware watchdog relay on the heartbeat output (Cy545Config::heartbeat_output).
-  fake_.board().arm_watchdog_relay(5, kWatchdogRelayNs, epoch_ns_);
+  // The rig's hardware watchdog relay on the heartbeat output (Mmc4sWiring::heartbeat_output).
+  fake_.board().arm_watchdog_relay(kMmc4sWiring.heartbeat_output, kWatchdogRelayNs, epoch_ns_);
   machined_.set_trace(job.trace);
   mill_.set_motion_observer(&machined_);
   char port_error[256] = {};
-  if (!port_.open(fake_.slave_path().c_str(), port_error)) {
+  if (!port_.open(fake_.slave_path().c_str(), kBaud, port_error)) {
     error_ = std::string("the fake CY545's pty: ") + port_error;
     return;
   }
-  link_ = std::make_unique<hal::cy545::Cy545Link>(port_, clock(), link_config(realtime));
+  link_ = std::make_unique<hal::cy545::Cy545Link>(port_, clock(), sim::link_config(realtime));  // the rig's, but (sim_facts.hpp)
 }
 
 MillWiring::~MillWiring() {

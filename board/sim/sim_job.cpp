@@ -25,18 +25,12 @@
 #include "sim/mill/machined_part.hpp"
 
 namespace stencil::board::sim {
-namespace {
-
-constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
-constexpr hal::MonotonicNs kUpdateNs = 1'000'000'000 / 30;
-constexpr double kModelCellMm = 0.05;  // the controller's stock model, as fine as the mill's Z-map
-
-}  // namespace
+// kPeriodNs, kUpdateNs, kModelCellMm, kPlannerLimits: sim_facts.hpp (the rig's).
 
 motion::MachineFrames frames() {
   // Every axis counts into the workspace from its switch, so the world runs against all three.
   return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
-          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), {-1, -1, -1}, 640.0};
+          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), rig::kRig.machine_sign, rig::kRig.steps_per_mm};
 }
 
 stencil::sim::StockBox default_stock(const tables::PartTables& part) {
@@ -59,7 +53,9 @@ control::ControllerConfig controller_config(bool realtime) {
   const Eigen::Vector3d device_workspace_mm =
       kDeviceMmPerWorldMm * Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]);
   // Overruns count in real time only: in virtual time lateness means nothing.
-  return runtime::controller_config({frames(), device_workspace_mm, kVirtualToolSpeedMmPerS, realtime});
+  return runtime::controller_config({frames(), device_workspace_mm, rig::kRig.device_reach_margin_mm,
+                                     rig::kRig.force_limit_n, rig::kRig.torque_limit_nmm, 1.0 / rig::kRig.haptic_rate_hz,
+                                     kVirtualToolSpeedMmPerS, realtime});
 }
 
 std::function<double(double, double)> touch_tip_of(const tables::PartTables& part, const stencil::sim::StockBox& stock) {
@@ -83,7 +79,7 @@ runtime::JobParts parts_of(const SimJob& job, MillWiring& mill, hal::HapticDevic
   parts.machine = &mill.link();
   parts.machine_clock = &mill.clock();
   parts.controller = controller_config(realtime);
-  parts.planner = {{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
+  parts.planner = kPlannerLimits;
   parts.period_ns = kPeriodNs;
   parts.update_ns = kUpdateNs;
   parts.shut_down_bound_ns = runtime::kUpdateBoundUpdates * kUpdateNs;

@@ -14,6 +14,7 @@
 #include <Eigen/Core>
 
 #include "board/sim/fault_injection.hpp"
+#include "board/sim/sim_facts.hpp"
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/control/cycle_messages.hpp"
 #include "firmware/core/control/display_feed.hpp"
@@ -29,16 +30,7 @@
 
 namespace stencil::board::sim {
 
-// The simulation board's frames: world = device / 10, device space [0,500]x[0,250]x[0,250]; the
-// machine homes with the tool at the workspace's far top corner (its X and Y switches at the
-// table's travel end, Z at the top), so every axis counts from there into the workspace.
-inline constexpr double kDeviceMmPerWorldMm = 10.0;
-inline constexpr double kHomeWorldMm[3] = {50.0, 25.0, 25.0};
-// What the mill really follows: 1.4 mm/s per axis and 1000 steps/s are its stepping, but each update
-// also spends about 15 ms of its 33 on the serial line, so the virtual tool is held to 1 mm/s (per
-// axis and |dx| + |dy| + |dz|), and the scripted hand moves a little slower than that.
-inline constexpr double kVirtualToolSpeedMmPerS = 1.0;
-inline constexpr double kOperatorSpeedMmPerS = 0.8;
+// The simulation board's frames, speeds and the rest of its facts: sim_facts.hpp (the rig's).
 
 // How the cycle reaches the simulated device: in process, or through the real backends' code over a
 // memfd window (the PIO card's layout) or a socketpair carrying CAN frames.

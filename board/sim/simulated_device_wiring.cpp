@@ -1,6 +1,8 @@
 // The simulated device's transports, and what an injected fault does to it.
 #include "board/sim/simulated_device_wiring.hpp"
 
+#include "board/sim/sim_facts.hpp"
+
 #include <limits>
 
 #include <sys/socket.h>
@@ -11,7 +13,7 @@ namespace stencil::board::sim {
 
 SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand,
                                              std::string& error)
-    : transport_(transport), direct_(hal::kCornerOriginHapticRange) {
+    : transport_(transport), direct_(kDeviceRange) {
   const auto pose = [&hand, this](std::uint32_t, hal::MonotonicNs) {
     const Eigen::Vector3d at = disturbed(hand.handle_mm);
     return stencil::sim::SimulatedPose{{at.x(), at.y(), at.z()}, {0.0, 0.0}};
@@ -22,7 +24,7 @@ SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const st
       return;
     }
     device_link_ = std::make_unique<stencil::sim::PioDeviceLink>(window_->window());
-    pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), hal::kCornerOriginHapticRange);
+    pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), kDeviceRange);
     host_ = pio_host_.get();
   } else if (transport == HapticTransport::Can) {
     int fds[2] = {-1, -1};
@@ -35,7 +37,7 @@ SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const st
     auto can_link = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
     can_device_link_ = can_link.get();
     device_link_ = std::move(can_link);
-    can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), hal::kCornerOriginHapticRange);
+    can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), kDeviceRange);
     host_ = can_host_.get();
   }
   if (device_link_ != nullptr) {

@@ -1,10 +1,11 @@
 #include "firmware/programs/rig_options.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <vector>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "board/sherline_suzuki/rig_devices.hpp"
 #include "firmware/programs/output_probe.hpp"
 
@@ -78,8 +79,10 @@ bool read_stock(const std::string& text, control::StockBlock& stock, std::string
     inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= workspace[a];
   }
   if (!inside) {
-    error = "--stock " + text +
-            ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace [0,50]x[0,25]x[0,25]";
+    char workspace_text[96];
+    std::snprintf(workspace_text, sizeof workspace_text, "[0,%g]x[0,%g]x[0,%g]", workspace[0], workspace[1], workspace[2]);
+    error = "--stock " + text + ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace " +
+            workspace_text;
     return false;
   }
   stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
@@ -89,6 +92,10 @@ bool read_stock(const std::string& text, control::StockBlock& stock, std::string
 }  // namespace
 
 void add_rig_options(CLI::App& app, RigOptions& options) {
+  namespace rig = board::sherline_suzuki;
+  char home_text[64];
+  std::snprintf(home_text, sizeof home_text, "%g,%g,%g", rig::kHomeWorldMm[0], rig::kHomeWorldMm[1], rig::kHomeWorldMm[2]);
+  options.offset_text = home_text;  // the machine's home before any touch-off
   add_job_options(app, options);
   add_record_options(app, options);
   add_display_options(app, options.display);

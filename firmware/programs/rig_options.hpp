@@ -19,7 +19,7 @@ struct RigOptions {
   bool require_rt = false;
   int priority = 80;
   int cpu = -1;
-  std::string offset_text = "50,25,25";
+  std::string offset_text;    // default: the rig's home (add_rig_options)
   double stick_out = 0.0;
   double reference_stick_out = 0.0;
   std::string stock_text;     // empty: the whole workspace

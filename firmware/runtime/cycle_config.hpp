@@ -12,6 +12,10 @@ namespace stencil::runtime {
 struct CycleFacts {
   motion::MachineFrames frames;           // device -> world -> machine
   Eigen::Vector3d device_workspace_mm;    // the device's workspace, from its corner origin
+  double device_reach_margin_mm;          // a sample this far outside the workspace is still a sample
+  double force_limit_n;                   // what the device may push with
+  double torque_limit_nmm;
+  double period_s;                        // the cycle's
   double virtual_tool_speed_mm_per_s;     // what the mill follows, per axis and |dx| + |dy| + |dz|
   bool count_overruns;                    // in real time; in virtual time lateness means nothing
 };

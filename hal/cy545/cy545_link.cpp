@@ -169,7 +169,7 @@ bool Cy545Link::force_outputs_off(MonotonicNs deadline_ns) {
   // The spindle's output latched off with the drivers already off (bit 0 is a level), then every bit
   // 0-5 low; each command on its own, so that none arrives while the chip takes the one before.
   CommandBytes commands[4]{};
-  const bool built = bit_command(write_bits_code(false, false, config_.spindle_output, false), commands[0]) &&
+  const bool built = bit_command(write_bits_code(false, false, config_.wiring.spindle_output, false), commands[0]) &&
                      bit_command(kWriteStrobeBit, commands[1]) && clear_bit_command(kWriteStrobeBit, commands[2]) &&
                      bit_command(write_bits_code(false, false, 0, false), commands[3]);
   for (const CommandBytes& command : commands) {
@@ -253,7 +253,7 @@ bool Cy545Link::select_channel(std::uint8_t channel, MonotonicNs deadline_ns) {
     return true;
   }
   if (motor_line_on_ != channel) {
-    if (config_.channel_lines_latch_data && motor_line_on_ >= 0 &&
+    if (config_.wiring.channel_lines_latch_data && motor_line_on_ >= 0 &&
         !latch_motor_line(static_cast<std::uint8_t>(motor_line_on_), false, deadline_ns)) {
       return false;
     }
@@ -354,8 +354,8 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
   // rates and no ramp.
   const bool initialised = bare_command('I', command) && send(command, deadline_ns) &&
                            number_command('O', kAsciiMode, 255, command) && send(command, deadline_ns) &&
-                           number_command('R', config_.step_rate, 27000, command) && send(command, deadline_ns) &&
-                           number_command('F', config_.step_rate, 27000, command) && send(command, deadline_ns) &&
+                           number_command('R', config_.motion.step_rate, 27000, command) && send(command, deadline_ns) &&
+                           number_command('F', config_.motion.step_rate, 27000, command) && send(command, deadline_ns) &&
                            number_command('S', 0, 255, command) && send(command, deadline_ns);
   if (!initialised) {
     return fault_ != MachineFault::None ? MachineResult{false, MachineRefusal::None, fault_}
@@ -379,7 +379,7 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
   drivers_on_ = false;
   spindle_on_ = false;
   homed_ = false;
-  rate_sent_ = config_.step_rate;
+  rate_sent_ = config_.motion.step_rate;
   state_ = MachineState::Ready;
   return {true, MachineRefusal::None, MachineFault::None};
 }
@@ -389,11 +389,11 @@ MonotonicNs Cy545Link::homing_bound_ns() const {
   // departure (at most two legs' worth of steps); every leg's commands and switch reads bounded by
   // three reply timeouts; three axes, and a margin. A bound, not an estimate: near home it is seconds.
   const MonotonicNs query_ns = 3 * config_.reply_timeout_ns;  // a leg's commands, the reads, their answers
-  const std::int64_t fast_steps = config_.home_switch_zone_steps + config_.homing_travel_steps;
-  const std::int64_t legs = fast_steps / std::max(config_.homing_chunk_steps, 1) + 2;
-  const std::int64_t slow_steps = std::max(config_.homing_chunk_steps, 1) + config_.homing_slack_steps;
-  const MonotonicNs axis_ns = steps_time_ns(fast_steps, config_.homing_rate) + legs * query_ns +
-                              steps_time_ns(slow_steps, config_.homing_slow_rate) +
+  const std::int64_t fast_steps = config_.motion.home_switch_zone_steps + config_.motion.homing_travel_steps;
+  const std::int64_t legs = fast_steps / std::max(config_.motion.homing_chunk_steps, 1) + 2;
+  const std::int64_t slow_steps = std::max(config_.motion.homing_chunk_steps, 1) + config_.motion.homing_slack_steps;
+  const MonotonicNs axis_ns = steps_time_ns(fast_steps, config_.motion.homing_rate) + legs * query_ns +
+                              steps_time_ns(slow_steps, config_.motion.homing_slow_rate) +
                               slow_steps * (query_ns + config_.pace_margin_ns);
   return 3 * axis_ns + 10 * kSecond;
 }
@@ -422,7 +422,7 @@ Cy545Link::SwitchReading Cy545Link::read_home_switch(std::size_t axis, Monotonic
       return SwitchReading::Failed;
     }
     const bool level = (levels & 0x02U) != 0;  // user bit 1: the input mux, with the read strobe on
-    closed += level == config_.home_switch_closed_level[axis] ? 1 : 0;
+    closed += level == config_.wiring.home_switch_closed_level[axis] ? 1 : 0;
   }
   return closed == reads ? SwitchReading::Closed : closed == 0 ? SwitchReading::Open : SwitchReading::Bouncing;
 }
@@ -458,16 +458,16 @@ bool Cy545Link::homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs d
 }
 
 // The approach runs toward the switch (-), the departure away from it (+): every axis's switch is
-// closed below its home (rig_constants.hpp), so the last steps of homing are + (home_approach()).
+// closed below its home (the rig's facts: board/<rig>/), so the last steps of homing are + (home_approach()).
 bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
   const char name = "XYZ"[axis];
-  if (!select_channel(config_.motor_channel[axis], deadline_ns) ||
-      !send_bits(write_bits_code(true, false, config_.home_input[axis], true), deadline_ns)) {
+  if (!select_channel(config_.wiring.motor_channel[axis], deadline_ns) ||
+      !send_bits(write_bits_code(true, false, config_.wiring.home_input[axis], true), deadline_ns)) {
     return false;
   }
   selected_channel_ = -1;  // the address lines now carry the input's number
-  homing_input_ = config_.home_input[axis];
-  const std::int32_t chunk = std::max(config_.homing_chunk_steps, 1);
+  homing_input_ = config_.wiring.home_input[axis];
+  const std::int32_t chunk = std::max(config_.motion.homing_chunk_steps, 1);
   const int debounce = std::max(config_.homing_debounce_reads, 1);
   // Before anything moves: a closed switch means the axis is inside its zone; leave it first.
   SwitchReading reading = read_home_switch(axis, deadline_ns, debounce);
@@ -475,7 +475,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     if (reading == SwitchReading::Failed || abort_asked()) {
       return false;
     }
-    if (left >= config_.home_switch_zone_steps) {
+    if (left >= config_.motion.home_switch_zone_steps) {
       std::snprintf(last_error_, sizeof last_error_,
                     "homing axis %c: its home switch still reads closed %d steps out of its zone: check its wiring and "
                     "the closed level in the configuration",
@@ -483,7 +483,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(chunk, config_.homing_rate, deadline_ns)) {
+    if (!homing_leg(chunk, config_.motion.homing_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, debounce);
@@ -493,7 +493,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     if (abort_asked()) {
       return false;
     }
-    if (travelled >= config_.homing_travel_steps) {
+    if (travelled >= config_.motion.homing_travel_steps) {
       std::snprintf(last_error_, sizeof last_error_,
                     "homing axis %c: no home switch within %d steps of travel: check the switch, its wiring and the "
                     "closed level in the configuration",
@@ -501,7 +501,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(-chunk, config_.homing_rate, deadline_ns)) {
+    if (!homing_leg(-chunk, config_.motion.homing_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, debounce);
@@ -516,13 +516,13 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     if (reading == SwitchReading::Failed || abort_asked()) {
       return false;
     }
-    if (stepped >= chunk + config_.homing_slack_steps) {
+    if (stepped >= chunk + config_.motion.homing_slack_steps) {
       std::snprintf(last_error_, sizeof last_error_, "homing axis %c: its home switch did not settle open within %d steps",
                     name, stepped);
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(1, config_.homing_slow_rate, deadline_ns)) {
+    if (!homing_leg(1, config_.motion.homing_slow_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, 1);
@@ -565,12 +565,12 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
   // Read strobe off, the moving rate back, then the position must be the home's.
   CommandBytes command{};
   std::uint32_t position = 1;
-  if (!send_bits(write_bits_code(true, false, config_.motor_channel[0], false), deadline_ns) ||
-      !number_command('R', config_.step_rate, 27000, command) || !send(command, deadline_ns) ||
+  if (!send_bits(write_bits_code(true, false, config_.wiring.motor_channel[0], false), deadline_ns) ||
+      !number_command('R', config_.motion.step_rate, 27000, command) || !send(command, deadline_ns) ||
       !query('P', position, deadline_ns)) {
     return {false, MachineRefusal::None, fault_};
   }
-  rate_sent_ = config_.step_rate;
+  rate_sent_ = config_.motion.step_rate;
   if (position != 0) {
     std::snprintf(last_error_, sizeof last_error_, "after homing the controller reports position %u, not 0", position);
     return fail(MachineFault::PositionMismatch);
@@ -623,8 +623,8 @@ MachineResult Cy545Link::move(const MachineTarget& target, MonotonicNs deadline_
     }
     total += std::abs(static_cast<std::int64_t>(target.motor_steps[axis]) - commanded_[axis]);
   }
-  const MonotonicNs duration = steps_time_ns(total, config_.step_rate);
-  if (static_cast<double>(duration) > config_.update_period_s * 1.05 * static_cast<double>(kSecond)) {
+  const MonotonicNs duration = steps_time_ns(total, config_.motion.step_rate);
+  if (static_cast<double>(duration) > config_.motion.update_period_s * 1.05 * static_cast<double>(kSecond)) {
     return refuse(MachineRefusal::TooLong);  // a hold must take effect within one update
   }
   if (deadline_ns - clock_.now_ns() < duration + 3 * config_.pace_margin_ns) {
@@ -637,7 +637,7 @@ MachineResult Cy545Link::move(const MachineTarget& target, MonotonicNs deadline_
       continue;
     }
     const auto steps = static_cast<std::uint32_t>(std::abs(delta));
-    if (!select_channel(config_.motor_channel[axis], deadline_ns) ||
+    if (!select_channel(config_.wiring.motor_channel[axis], deadline_ns) ||
         !number_command('N', steps, kMax24, command) || !send(command, deadline_ns) ||
         !bare_command(delta > 0 ? '+' : '-', command) || !send(command, deadline_ns) ||
         !bare_command('G', command) || !send(command, deadline_ns)) {
@@ -645,7 +645,7 @@ MachineResult Cy545Link::move(const MachineTarget& target, MonotonicNs deadline_
     }
     commanded_[axis] = target.motor_steps[axis];
     position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + delta) & kMax24;
-    const MonotonicNs leg = steps_time_ns(steps, config_.step_rate);
+    const MonotonicNs leg = steps_time_ns(steps, config_.motion.step_rate);
     started_running(leg, leg + config_.pace_margin_ns);
   }
   ++moves_done_;
@@ -679,7 +679,7 @@ MachineResult Cy545Link::set_spindle(bool on, MonotonicNs deadline_ns) {
   if (state_ == MachineState::Closed || state_ == MachineState::Open) {
     return refuse(MachineRefusal::NotHomed);
   }
-  if (!send_bits(write_bits_code(drivers_on_, on, config_.spindle_output, false), deadline_ns) || !latch(deadline_ns)) {
+  if (!send_bits(write_bits_code(drivers_on_, on, config_.wiring.spindle_output, false), deadline_ns) || !latch(deadline_ns)) {
     return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
   }
   selected_channel_ = -1;  // the address lines were the spindle output's
@@ -688,7 +688,7 @@ MachineResult Cy545Link::set_spindle(bool on, MonotonicNs deadline_ns) {
 }
 
 MachineResult Cy545Link::keep_alive(MonotonicNs deadline_ns) {
-  if (config_.heartbeat_output < 0) {
+  if (config_.wiring.heartbeat_output < 0) {
     return {true, MachineRefusal::None, MachineFault::None};
   }
   if (fault_ != MachineFault::None) {
@@ -700,13 +700,13 @@ MachineResult Cy545Link::keep_alive(MonotonicNs deadline_ns) {
   if (clock_.now_ns() < heartbeat_due_ns_) {
     return {true, MachineRefusal::None, MachineFault::None};
   }
-  const auto port = static_cast<std::uint8_t>(config_.heartbeat_output);
+  const auto port = static_cast<std::uint8_t>(config_.wiring.heartbeat_output);
   if (!send_bits(write_bits_code(drivers_on_, !heartbeat_level_, port, false), deadline_ns) || !latch(deadline_ns)) {
     return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
   }
   selected_channel_ = -1;  // the address lines were the heartbeat output's (the motor line stays latched)
   heartbeat_level_ = !heartbeat_level_;
-  heartbeat_due_ns_ = clock_.now_ns() + config_.heartbeat_period_ns / 2;
+  heartbeat_due_ns_ = clock_.now_ns() + config_.wiring.heartbeat_period_ns / 2;
   return {true, MachineRefusal::None, MachineFault::None};
 }
 

@@ -35,29 +35,38 @@
 
 #include "hal/clock.hpp"
 #include "hal/cy545/cy545_commands.hpp"
+#include "hal/cy545/mmc4s_wiring.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/machine_link.hpp"
 
 namespace stencil::hal::cy545 {
 
-struct Cy545Config {
-  std::uint32_t step_rate = 1000;            // steps/s of every move (R and F: no ramp)
+// What the rig's mill can follow and how far its homing may run, in its motor steps: facts of the rig
+// too, which its board passes in. No defaults here.
+struct Cy545Motion {
+  std::uint32_t step_rate;     // steps/s of every move (R and F: no ramp)
+  double update_period_s;      // one machine update: a move that takes longer is refused
   // Homing, per axis: the switch read first (closed: leave it), then an approach in chunks of
   // homing_chunk_steps at homing_rate with the switch read after each, until it closes (or
   // homing_travel_steps: a fault), then a slow departure one step at a time at homing_slow_rate
   // until it reads open homing_debounce_reads times in a row: that edge is home.
-  std::uint32_t homing_rate = 800;           // steps/s (1.25 mm/s: under the Sherline's 1.4 mm/s)
-  std::uint32_t homing_slow_rate = 200;      // steps/s for the last, edge-finding steps
-  std::int32_t homing_chunk_steps = 64;      // 0.1 mm: how far the approach may run into the switch
+  std::uint32_t homing_rate;          // steps/s
+  std::uint32_t homing_slow_rate;     // steps/s for the last, edge-finding steps
+  std::int32_t homing_chunk_steps;    // how far the approach may run into the switch
   // The departure turns the backlash before the axis moves: at most a leg plus this many steps.
-  std::int32_t homing_slack_steps = 256;     // 0.4 mm: above the Sherline's largest backlash (80 steps)
-  std::int32_t homing_travel_steps = 40960;  // the longest approach of one axis (64 mm)
-  std::int32_t home_switch_zone_steps = 2560;  // the switch's closed zone (4 mm): a switch still closed this far out is miswired
+  std::int32_t homing_slack_steps;
+  std::int32_t homing_travel_steps;     // the longest approach of one axis
+  std::int32_t home_switch_zone_steps;  // the switch's closed zone: a switch still closed this far out is miswired
+};
+
+// The driver's configuration: the rig's wiring and motion (given), and the driver's own timing.
+struct Cy545Config {
+  constexpr Cy545Config(const Mmc4sWiring& rig_wiring, const Cy545Motion& rig_motion)
+      : wiring(rig_wiring), motion(rig_motion) {}
+
+  Mmc4sWiring wiring;
+  Cy545Motion motion;
   int homing_debounce_reads = 3;             // equal reads in a row that settle the switch's state
-  // The level user bit 1 reads, through the input mux, while an axis's home switch is CLOSED: a rig
-  // fact (normally-open switches pulled up read 0), never guessed: wrong, the approach runs away.
-  std::array<bool, 3> home_switch_closed_level = {true, true, true};
-  double update_period_s = 1.0 / 30.0;       // a move that takes longer is refused
   MonotonicNs reply_timeout_ns = 50'000'000; // a query's answer
   MonotonicNs pace_margin_ns = 5'000'000;    // beyond its computed time a move is overdue (+ reply_timeout: a fault)
   MonotonicNs probe_interval_ns = 1'000'000; // carriage returns while waiting for "? P" to be answered
@@ -67,19 +76,6 @@ struct Cy545Config {
   // bytes wait in the chip's buffer, so a settle s covers an execution time up to s + 4 byte times
   // (0.69 ms at 57600 baud): 0.5 ms covers 1.2 ms. The manual gives no figure: measure it at the rig.
   MonotonicNs command_settle_ns = 500'000;
-  std::array<std::uint8_t, 3> motor_channel = {0, 1, 2};      // output-mux port of x y z
-  std::array<std::uint8_t, 3> home_input = {0, 1, 2};         // input-mux port of their switches
-  std::uint8_t spindle_output = 4;                            // general-purpose output (1 = on)
-  // The watchdog relay's heartbeat: a general-purpose output toggled every heartbeat_period_ns / 2
-  // while the machine side runs (homing included); -1: none (a rig without the relay).
-  int heartbeat_output = 5;
-  // How the MMC-4S latches a motor channel (its manual is not at hand): true, each line latches its
-  // data bit, so the old channel's line is latched off before the new one's on (right under either
-  // reading, at six commands a change of axis instead of three); false, the board latches the
-  // address (the thesis's table 5-1: output ports 0-3 are "motor/driver addresses"), one select.
-  // Measure it at commissioning: select X, then Y, step, and see whether X moves.
-  bool channel_lines_latch_data = true;
-  MonotonicNs heartbeat_period_ns = 400'000'000;  // the relay drops after about 1 s without a change
 };
 
 class Cy545Link final : public MachineLink {

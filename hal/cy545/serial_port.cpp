@@ -25,6 +25,24 @@ int poll_timeout_ms(MonotonicNs deadline_ns, const Clock& clock) {
   return ms > 60'000 ? 60'000 : static_cast<int>(ms);
 }
 
+// The termios speed of a baud rate; B0 for a rate not offered here.
+speed_t speed_of(std::uint32_t baud) {
+  switch (baud) {
+    case 9600:
+      return B9600;
+    case 19200:
+      return B19200;
+    case 38400:
+      return B38400;
+    case 57600:
+      return B57600;
+    case 115200:
+      return B115200;
+    default:
+      return B0;
+  }
+}
+
 }  // namespace
 
 SerialPort::~SerialPort() { close(); }
@@ -40,8 +58,13 @@ void SerialPort::close() {
   }
 }
 
-bool SerialPort::open(const char* path, char (&error)[256]) {
+bool SerialPort::open(const char* path, std::uint32_t baud, char (&error)[256]) {
   close();
+  if (speed_of(baud) == B0) {
+    std::snprintf(error, sizeof error, "%s: %u baud: expected 9600, 19200, 38400, 57600 or 115200", path,
+                  static_cast<unsigned>(baud));
+    return false;
+  }
   const int fd = ::open(path, O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (fd < 0 && errno == EBUSY) {
     // Another program holds the port with TIOCEXCL.
@@ -100,8 +123,8 @@ bool SerialPort::open(const char* path, char (&error)[256]) {
   int lines = 0;
   modem_lines_ = ioctl(fd, TIOCMGET, &lines) == 0;
   cfmakeraw(&settings);
-  cfsetispeed(&settings, B57600);
-  cfsetospeed(&settings, B57600);
+  cfsetispeed(&settings, speed_of(baud));
+  cfsetospeed(&settings, speed_of(baud));
   settings.c_cflag &= ~static_cast<tcflag_t>(CSIZE | PARENB | CSTOPB);
   settings.c_cflag |= CS8 | CREAD | CLOCAL;
   // No hang-up on close: with HUPCL the kernel drops DTR and RTS when the port closes, and the
@@ -115,7 +138,7 @@ bool SerialPort::open(const char* path, char (&error)[256]) {
   settings.c_cc[VMIN] = 1;  // with O_NONBLOCK: EAGAIN when nothing waits (VMIN 0 would read 0, like a hang-up)
   settings.c_cc[VTIME] = 0;
   if (tcsetattr(fd, TCSANOW, &settings) != 0) {
-    std::snprintf(error, sizeof error, "%s: cannot set 57600 8N1 raw: %s", path, std::strerror(errno));
+    std::snprintf(error, sizeof error, "%s: cannot set %u 8N1 raw: %s", path, static_cast<unsigned>(baud), std::strerror(errno));
     close();
     return false;
   }

@@ -1,5 +1,5 @@
-// The RS-232 port to the CY545: opened exclusively and configured once (57600 8N1, raw, CRTSCTS
-// where the port has modem lines), then byte I/O that never waits past a deadline.
+// The RS-232 port to the CY545: opened exclusively and configured once (8N1 at the rig's baud rate,
+// raw, no hardware flow control), then byte I/O that never waits past a deadline.
 #pragma once
 
 #include <cstddef>
@@ -27,10 +27,10 @@ class SerialPort {
   // Init-time. Opens `path` and holds it for this program alone: an advisory flock (refuses a
   // second rig, even as root) and TIOCEXCL (any other non-root open fails with EBUSY). A port
   // another program holds locked or exclusively is refused, "in use by another program". Then
-  // configures it, HUPCL cleared so that closing the port leaves DTR and RTS up. False with a
-  // message naming the path and the failing step (cannot open, not a tty, in use, termios refused)
-  // in `error`.
-  [[nodiscard]] bool open(const char* path, char (&error)[256]);
+  // configures it, 8N1 at `baud` (the rig's: 9600, 19200, 38400, 57600 or 115200), HUPCL cleared
+  // so that closing the port leaves DTR and RTS up. False with a message naming the path and the
+  // failing step (cannot open, not a tty, in use, termios refused) in `error`.
+  [[nodiscard]] bool open(const char* path, std::uint32_t baud, char (&error)[256]);
   // Init-time. Clears the exclusive flag and closes the port, which releases the lock.
   void close();
   [[nodiscard]] bool is_open() const { return fd_ >= 0; }

@@ -29,7 +29,8 @@ void make_raw(int fd, const char* what) {
 
 }  // namespace
 
-FakeCy545::FakeCy545(SimulatedMill& mill, hal::MonotonicNs start_ns) : board_(mill), chip_(board_, start_ns) {
+FakeCy545::FakeCy545(SimulatedMill& mill, const hal::cy545::Mmc4sWiring& wiring, hal::MonotonicNs start_ns)
+    : board_(mill, wiring), chip_(board_, start_ns) {
   master_fd_ = posix_openpt(O_RDWR | O_NOCTTY | O_NONBLOCK | O_CLOEXEC);
   if (master_fd_ < 0) fail("posix_openpt");
   try {

@@ -30,7 +30,8 @@ class FakeCy545 {
   // Opens the pty (posix_openpt, grantpt, unlockpt, ptsname), puts it in raw mode, makes the master
   // non-blocking, and keeps a slave descriptor of its own so that the master never sees a hang-up
   // when the driver closes and reopens the slave. Throws std::system_error naming the failing call.
-  FakeCy545(SimulatedMill& mill, hal::MonotonicNs start_ns);
+  // `wiring`: how the rig's MMC-4S board is wired (its board's facts), as the driver is told too.
+  FakeCy545(SimulatedMill& mill, const hal::cy545::Mmc4sWiring& wiring, hal::MonotonicNs start_ns);
   ~FakeCy545();
   FakeCy545(const FakeCy545&) = delete;
   FakeCy545& operator=(const FakeCy545&) = delete;

@@ -3,28 +3,25 @@
 
 #include <cstddef>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
 #include "sim/cy545/cy545_protocol.hpp"
 
 namespace stencil::sim::cy545 {
 
 namespace {
 
-namespace rig = board::sherline_suzuki;
-
 bool bit_of(std::uint8_t bits, int bit) { return ((static_cast<unsigned>(bits) >> bit) & 1u) != 0; }
 int address_of(std::uint8_t bits) { return (bits >> kBitAddressLow) & 0x7; }
 
 }  // namespace
 
-Mmc4sBoard::Mmc4sBoard(SimulatedMill& mill) : mill_(mill) {
+Mmc4sBoard::Mmc4sBoard(SimulatedMill& mill, const hal::cy545::Mmc4sWiring& wiring) : mill_(mill), wiring_(wiring) {
   mill_.set_drivers_enabled(false);
   mill_.set_spindle_on(false);
 }
 
 void Mmc4sBoard::apply_power() {
   mill_.set_drivers_enabled(drivers_latched_ && relay_closed_);
-  mill_.set_spindle_on(outputs_[static_cast<std::size_t>(rig::kMmc4s.spindle_output)] && relay_closed_);
+  mill_.set_spindle_on(outputs_[wiring_.spindle_output] && relay_closed_);
 }
 
 void Mmc4sBoard::arm_watchdog_relay(int port, hal::MonotonicNs timeout_ns, hal::MonotonicNs now_ns) {
@@ -67,15 +64,15 @@ void Mmc4sBoard::on_user_bits_written(std::uint8_t before, std::uint8_t after, h
 }
 
 std::optional<Axis> Mmc4sBoard::axis_of_channel(int channel) const {
-  for (int axis = 0; axis < rig::kAxisCount; ++axis) {
-    if (rig::kMmc4s.motor_channel[axis] == channel) return static_cast<Axis>(axis);
+  for (int axis = 0; axis < kMillAxisCount; ++axis) {
+    if (wiring_.motor_channel[static_cast<std::size_t>(axis)] == channel) return static_cast<Axis>(axis);
   }
   return std::nullopt;
 }
 
 bool Mmc4sBoard::input_level(int port) const {
-  for (int axis = 0; axis < rig::kAxisCount; ++axis) {
-    if (rig::kMmc4s.home_sensor_input[axis] != port) continue;
+  for (int axis = 0; axis < kMillAxisCount; ++axis) {
+    if (wiring_.home_input[static_cast<std::size_t>(axis)] != port) continue;
     const auto a = static_cast<Axis>(axis);
     bool closed = mill_.home_switch_closed(a);
     const std::int64_t from_edge =

@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "hal/clock.hpp"
+#include "hal/cy545/mmc4s_wiring.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
 namespace stencil::sim::cy545 {
@@ -22,7 +23,9 @@ enum class ChannelLatching : std::uint8_t {
 
 class Mmc4sBoard {
  public:
-  explicit Mmc4sBoard(SimulatedMill& mill);
+  // `wiring`: which output-mux port selects each axis's motor, which input-mux port reads its home
+  // switch, which general-purpose output runs the spindle (the rig's board gives it).
+  Mmc4sBoard(SimulatedMill& mill, const hal::cy545::Mmc4sWiring& wiring);
 
   void set_channel_latching(ChannelLatching latching) { latching_ = latching; }
 
@@ -66,6 +69,7 @@ class Mmc4sBoard {
   [[nodiscard]] std::optional<Axis> axis_of_channel(int channel) const;
 
   SimulatedMill& mill_;
+  hal::cy545::Mmc4sWiring wiring_;
   ChannelLatching latching_ = ChannelLatching::PerLine;
   std::array<bool, 4> channel_on_{};  // motor channels 0..3 (Address: at most one)
   std::array<bool, 8> outputs_{};         // general-purpose outputs 4..7 (0..3 unused)

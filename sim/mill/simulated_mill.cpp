@@ -3,8 +3,6 @@
 
 #include <cstddef>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
-
 namespace stencil::sim {
 
 namespace {
@@ -12,21 +10,6 @@ namespace {
 std::size_t index_of(Axis axis) { return static_cast<std::size_t>(axis); }
 
 }  // namespace
-
-MillConfig sherline_mill_config() {
-  namespace rig = board::sherline_suzuki;
-  MillConfig config{};
-  config.steps_per_mm = rig::kRig.steps_per_mm;
-  for (int axis = 0; axis < rig::kAxisCount; ++axis) {
-    MillAxisConfig& a = config.axes[static_cast<std::size_t>(axis)];
-    a.backlash_steps = rig::backlash_steps(axis);
-    a.travel_min_steps = rig::mm_to_steps(rig::travel_min_mm(axis));
-    a.travel_max_steps = rig::mm_to_steps(rig::travel_max_mm(axis));
-    a.home_switch_edge_steps = rig::mm_to_steps(rig::kHomeSwitchEdgeMm);
-    a.initial_position_steps = rig::mm_to_steps(rig::kRig.workspace_mm[axis] / 2.0);
-  }
-  return config;
-}
 
 SimulatedMill::SimulatedMill(const MillConfig& config) : config_(config) {
   for (std::size_t i = 0; i < axes_.size(); ++i) {

@@ -13,7 +13,8 @@ inline constexpr int kMillAxisCount = 3;
 // The sign of one motor step. Positive moves the axis towards larger machine coordinates.
 enum class StepDirection : std::int8_t { positive = 1, negative = -1 };
 
-// One axis, every length in motor steps (1/640 mm on the Sherline).
+// One axis, every length in motor steps. A board gives them (the simulated Sherline mill's:
+// board/sim/sim_facts.hpp, from the rig's facts).
 struct MillAxisConfig {
   std::int64_t backlash_steps;       // play between screw and nut, taken up on every reversal
   std::int64_t travel_min_steps;     // low hard stop (the axis cannot go below it)
@@ -26,10 +27,6 @@ struct MillConfig {
   std::array<MillAxisConfig, kMillAxisCount> axes;
   double steps_per_mm;
 };
-
-// The Sherline rig's mill from board/sherline_suzuki/rig_constants.hpp; power-up in mid-workspace
-// with the slack on the negative side (as after a positive move).
-MillConfig sherline_mill_config();
 
 // What one motor step did.
 enum class StepOutcome : std::uint8_t {

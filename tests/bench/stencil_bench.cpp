@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/stencil/contact_query.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
@@ -164,6 +165,8 @@ int main(int argc, char** argv) {
     // About a third as many triangles as points; the rest of the points seeded on the surface.
     const std::vector<tablegen::Facet> facets = stepped_field(target / 3);
     tablegen::GeneratorOptions options;
+    const auto& workspace = board::sherline_suzuki::kRig.workspace_mm;  // the rig's, as stencil-tablegen's
+    options.placement.workspace_mm = {workspace[0], workspace[1], workspace[2]};
     options.tool = tablegen::parse_tool("ball:d=3", "");
     options.spacing_mm = 50.0;  // fine triangles: vertices and centroids, no subdivision
     options.force = true;

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/tables/table_loader.hpp"
 #include "sim/haptic_device/direct_haptic_device.hpp"
@@ -25,7 +26,7 @@ int main() {
   static control::MachineHandoffRing handoffs;
   static control::TelemetryRing telemetry;
   static control::JournalRing journal;
-  static sim::DirectHapticDevice device{hal::kCornerOriginHapticRange};
+  static sim::DirectHapticDevice device{stencil::board::sherline_suzuki::kDeviceRange};
   control::ControllerConfig config;
   config.frames = {10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d(25.0, 12.5, 20.0), {-1, -1, 1}, 640.0};
   config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);

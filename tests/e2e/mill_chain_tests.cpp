@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <vector>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
+#include "board/sim/sim_facts.hpp"
 #include "firmware/core/motion/machine_planner.hpp"
 #include "firmware/core/motion/speed_limit.hpp"
 #include "firmware/core/stencil/sweep.hpp"
@@ -25,6 +27,7 @@
 #include <CppUTest/TestHarness.h>
 
 using namespace stencil;
+namespace rig = stencil::board::sherline_suzuki;
 using stencil::sim::Axis;
 using stencil::sim::StepDirection;
 
@@ -44,23 +47,24 @@ TEST(MillChain, TheMillFollowsTheVirtualToolRoundTheHexPrismThroughTheRealDriver
   // The machine homes with the tool beside the prism's vertex at (33, 12.5), low enough for the
   // cutter's side to meet the walls.
   const Eigen::Vector3d home(33.0, 9.5, 2.0);
-  const motion::MachineFrames frames{10.0, Eigen::Vector3d::Zero(), home, {-1, -1, 1}, 640.0};
-  const motion::PlannerLimits limits{{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
+  const motion::MachineFrames frames{rig::kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, {-1, -1, 1},
+                                     rig::kRig.steps_per_mm};
+  const motion::PlannerLimits limits = rig::kPlannerLimits;
 
-  sim::SimulatedMill mill{sim::sherline_mill_config()};
+  sim::SimulatedMill mill{board::sim::kMillConfig};
   mill.place_axis(Axis::x, 150, StepDirection::positive);
   mill.place_axis(Axis::y, 60, StepDirection::positive);
   mill.place_axis(Axis::z, 190, StepDirection::positive);
-  sim::cy545::FakeCy545 fake{mill, hal::posix_clock::monotonic_now_ns()};
+  sim::cy545::FakeCy545 fake{mill, board::sim::kMmc4sWiring, hal::posix_clock::monotonic_now_ns()};
   hal::posix_clock::MonotonicClock clock;
   hal::cy545::SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(fake.slave_path().c_str(), error), error);
-  hal::cy545::Cy545Config config;
-  config.homing_rate = 20000;
-  config.homing_slow_rate = 5000;
+  CHECK_TEXT(port.open(fake.slave_path().c_str(), rig::kRig.serial_baud, error), error);
+  hal::cy545::Cy545Config config = rig::kCy545;
+  config.motion.homing_rate = 20000;
+  config.motion.homing_slow_rate = 5000;
   config.reply_timeout_ns = 1000 * kMs;  // the fake is a thread on a host that is not real-time (and CI's sanitizers)
-  config.homing_travel_steps = 2000;
+  config.motion.homing_travel_steps = 2000;
   hal::cy545::Cy545Link link(port, clock, config);
   sim::cy545::FakeCy545Runner runner{fake};
   CHECK_TEXT(link.start(clock.now_ns() + 2000 * kMs).done, link.last_error());

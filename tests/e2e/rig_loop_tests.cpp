@@ -14,6 +14,7 @@
 #include <pthread.h>
 #include <sched.h>
 
+#include "board/sim/sim_facts.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
@@ -41,8 +42,8 @@ namespace {
 struct FakeRig {
   tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
   tables::PartTables part{};
-  sim::SimulatedMill mill{sim::sherline_mill_config()};
-  sim::cy545::FakeCy545 fake{mill, hal::posix_clock::monotonic_now_ns()};
+  sim::SimulatedMill mill{board::sim::kMillConfig};
+  sim::cy545::FakeCy545 fake{mill, board::sim::kMmc4sWiring, hal::posix_clock::monotonic_now_ns()};
   std::unique_ptr<sim::cy545::FakeCy545Runner> fake_runner;
   hal::cy545::SerialPort port;
   hal::posix_clock::MonotonicClock clock;
@@ -66,10 +67,10 @@ struct FakeRig {
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
     fake_runner = std::make_unique<sim::cy545::FakeCy545Runner>(fake);
     char port_error[256] = {};
-    CHECK_TRUE(port.open(fake.slave_path().c_str(), port_error));
-    hal::cy545::Cy545Config config;
-    config.homing_rate = 20000;  // the fake homes in a fraction of a second
-    config.homing_slow_rate = 5000;
+    CHECK_TRUE(port.open(fake.slave_path().c_str(), rig::kRig.serial_baud, port_error));
+    hal::cy545::Cy545Config config = rig::kCy545;
+    config.motion.homing_rate = 20000;  // the fake homes in a fraction of a second
+    config.motion.homing_slow_rate = 5000;
     config.reply_timeout_ns = 1'000'000'000;  // the fake is a thread on a host that is not real-time (and CI's sanitizers)
     link = std::make_unique<hal::cy545::Cy545Link>(port, clock, config);
     window = hal::pio_shared_memory::SharedWindowMapping::create_memfd("rig-loop-tests", error);
@@ -78,7 +79,7 @@ struct FakeRig {
     // The device trips after 200 ms of a frozen host heartbeat, not the card's 20: the host cycle here
     // is a thread on a host that is not real-time (as stale_periods and overrun_limit below).
     device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, pose, 200'000'000);
-    host = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), hal::kCornerOriginHapticRange);
+    host = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window->window(), rig::kDeviceRange);
     device->step(hal::posix_clock::monotonic_now_ns());
     device_thread = std::thread([this] {
       // The device's own loop is hard real time on its card: SCHED_FIFO here where allowed, so

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <cstring>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/haptic_device.hpp"
 #include "hal/socketcan/can_codec.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
@@ -17,7 +18,7 @@ using stencil::fuzz::require;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::hal;
   using namespace stencil::hal::socketcan;
-  HostFrameAssembler host(kDefaultHapticRange);
+  HostFrameAssembler host(stencil::board::sherline_suzuki::kCentredDeviceRange);
   DeviceFrameAssembler device;
   for (std::size_t offset = 0; offset + sizeof(can_frame) <= size; offset += sizeof(can_frame)) {
     can_frame frame{};
@@ -26,15 +27,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     if (from_device.effect == FrameEffect::Completed) {
       const PoseWire& pose = host.latest_pose();
       for (int axis = 0; axis < 3; ++axis) {
-        require(std::abs(pose.position_um[axis] * 1e-3 - kDefaultHapticRange.position_centre_mm[axis]) <=
-                kDefaultHapticRange.position_limit_mm[axis]);
+        require(std::abs(pose.position_um[axis] * 1e-3 - stencil::board::sherline_suzuki::kCentredDeviceRange.position_centre_mm[axis]) <=
+                stencil::board::sherline_suzuki::kCentredDeviceRange.position_limit_mm[axis]);
       }
     }
     const FrameResult from_host = device.accept(frame);
     if (from_host.effect == FrameEffect::Completed) {
       const CommandWire& command = device.latest_command();
       for (int axis = 0; axis < 3; ++axis) {
-        require(std::abs(command.force_mn[axis]) <= static_cast<int>(kDefaultHapticRange.force_limit_n * 1000.0));
+        require(std::abs(command.force_mn[axis]) <= static_cast<int>(stencil::board::sherline_suzuki::kCentredDeviceRange.force_limit_n * 1000.0));
       }
     }
   }

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 #include "toolchain/tablegen/table_generator.hpp"
@@ -42,6 +43,8 @@ std::vector<std::byte> read_file(const std::filesystem::path& path) {
 void write_table(const std::filesystem::path& stl_path, const std::string& tool, double spacing_mm,
                  const std::filesystem::path& table_path) {
   stencil::tablegen::GeneratorOptions options;
+  const auto& workspace = stencil::board::sherline_suzuki::kRig.workspace_mm;  // the rig's, as stencil-tablegen's
+  options.placement.workspace_mm = {workspace[0], workspace[1], workspace[2]};
   options.tool = stencil::tablegen::parse_tool(tool, "");
   options.spacing_mm = spacing_mm;
   options.force = true;
@@ -71,7 +74,7 @@ int main(int argc, char** argv) {
   try {
     fs::create_directories(stl_dir);
     fs::create_directories(table_dir);
-    // Parts centred in the default 50 x 25 x 25 mm workspace, a few mm across.
+    // Parts centred in the rig's 50 x 25 x 25 mm workspace, a few mm across.
     write_stl((stl_dir / "tetrahedron_ascii.stl").string(), tetrahedron(3.0, 24.0, 11.0), false, "tetrahedron");
     write_stl((stl_dir / "tetrahedron_binary.stl").string(), tetrahedron(3.0, 24.0, 11.0), true, "tetrahedron");
     write_stl((stl_dir / "hex_prism_ascii.stl").string(), hexagonal_prism(3.0, 2.0, 25.0, 12.5), false, "hex_prism");

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <ctime>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
@@ -60,7 +61,7 @@ int main() {
     return 1;
   }
   sim::SimulatedHapticDevice pio_device(pio_link, test::counter_pose);
-  hal::pio_shared_memory::PioHapticDevice pio_host(&windows.host->window(), hal::kDefaultHapticRange);
+  hal::pio_shared_memory::PioHapticDevice pio_host(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   const unsigned long pio_fresh = run(pio_host, pio_device, cycles);
 
   // SocketCAN: frames through a socketpair.
@@ -73,7 +74,7 @@ int main() {
   hal::socketcan::FdCanChannel device_channel(fds[1]);
   sim::CanDeviceLink can_link(device_channel);
   sim::SimulatedHapticDevice can_device(can_link, test::counter_pose);
-  hal::socketcan::SocketCanHapticDevice can_host(&host_channel, hal::kDefaultHapticRange);
+  hal::socketcan::SocketCanHapticDevice can_host(&host_channel, stencil::board::sherline_suzuki::kCentredDeviceRange);
   const unsigned long can_fresh = run(can_host, can_device, cycles);
 
   const bool ok = stencil::test::trapped_heap_calls() == 0 && pio_fresh > cycles / 2 && can_fresh > cycles / 2;

@@ -10,7 +10,11 @@
 
 namespace stencil::test {
 
-// Generator options for the default job: a 3 mm ball end mill under the default holder.
+// The rig's placement: its workspace (board/sherline_suzuki/rig_facts.hpp), the part as it is.
+tablegen::PlacementOptions rig_placement();
+
+// Generator options for the default job: a 3 mm ball end mill under the default holder, for the rig
+// (its workspace, its backlash), as stencil-tablegen's defaults are.
 tablegen::GeneratorOptions default_job_options(unsigned threads = 1);
 
 // The table bytes for the facets with the given options (the STL passes through encode_stl).

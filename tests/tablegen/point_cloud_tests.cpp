@@ -3,6 +3,7 @@
 #include <random>
 #include <vector>
 
+#include "tests/support/sample_tables.hpp"
 #include "tests/support/stl_meshes.hpp"
 #include "toolchain/tablegen/point_cloud.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
@@ -16,7 +17,7 @@ using stencil::geometry::ToolSpec;
 
 namespace {
 
-PartMesh mesh_of(const std::vector<Facet>& facets) { return prepare_part(stencil::test::mesh_of(facets), {}, "part.stl"); }
+PartMesh mesh_of(const std::vector<Facet>& facets) { return prepare_part(stencil::test::mesh_of(facets), stencil::test::rig_placement(), "part.stl"); }
 
 // Awkward triangles: acute, right, very obtuse (a sliver) and large.
 std::vector<Facet> awkward_facets() {

@@ -15,6 +15,7 @@
 #include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/inspect.hpp"
+#include "toolchain/tablegen/rig_defaults.hpp"
 #include "toolchain/tablegen/table_generator.hpp"
 #include "toolchain/tablegen/table_writer.hpp"
 #include "toolchain/tablegen/tool_option.hpp"
@@ -90,9 +91,12 @@ int main(int argc, char** argv) {
   std::string holder_text;
   std::optional<double> spacing;
   GeneratorOptions options;
+  // The rig's, from the board this program is linked with.
+  const RigDefaults rig = rig_defaults();
+  options.rig_largest_backlash_mm = rig.largest_backlash_mm;
   std::string units = "mm";
   std::string place = "as-is";
-  std::vector<double> workspace{50.0, 25.0, 25.0};
+  std::vector<double> workspace(rig.workspace_mm.begin(), rig.workspace_mm.end());
   std::string emit_directory;
   std::string inspect_path;
   bool json = false;

@@ -146,7 +146,8 @@ PartMesh prepare_part(const StlMesh& stl, const PlacementOptions& options, const
   }
   const char* axis_names[] = {"x", "y", "z"};
   for (int axis = 0; axis < 3; ++axis) {
-    if (low[axis] < -1e-9 || high[axis] > options.workspace_mm[axis] + 1e-9) {
+    // (Written so that a workspace never given, not a number, refuses every part.)
+    if (low[axis] < -1e-9 || !(high[axis] <= options.workspace_mm[axis] + 1e-9)) {
       throw InputError(file_name + ": the placed part spans " + axis_names[axis] + " " +
                        range_text(low[axis], high[axis]) + " mm, outside the workspace " +
                        range_text(0.0, options.workspace_mm[axis]) +

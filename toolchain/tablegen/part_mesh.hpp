@@ -5,6 +5,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -20,7 +21,9 @@ struct PlacementOptions {
   double millimetres_per_unit = 1.0;  // 25.4 for --units in
   double scale = 1.0;                 // --scale, applied after the units
   Placement placement = Placement::AsIs;
-  Eigen::Vector3d workspace_mm{50.0, 25.0, 25.0};
+  // The rig's machine workspace, the box [0,X]x[0,Y]x[0,Z] (the caller's: the program's is the rig's,
+  // rig_defaults.hpp). Not a number until given: refused.
+  Eigen::Vector3d workspace_mm = Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
   bool flip = false;                  // reverse every facet (for meshes whose normals point inward)
 };
 

@@ -7,7 +7,6 @@
 
 #include <nettle/sha2.h>
 
-#include "board/sherline_suzuki/rig_constants.hpp"
 #include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "firmware/core/tables/tool_section.hpp"
 #include "toolchain/tablegen/bvh_builder.hpp"
@@ -67,7 +66,7 @@ void collect_warnings(const std::string& file_name, const GeneratorOptions& opti
                        number(mesh.signed_volume_mm3) + " mm^3)" +
                        (options.placement.flip ? "" : "; use --flip to turn them outward"));
   }
-  const double backlash = board::sherline_suzuki::largest_backlash_mm();
+  const double backlash = options.rig_largest_backlash_mm;
   if (options.allowance_mm < backlash) {
     warnings.push_back("allowance " + number(options.allowance_mm) + " mm is smaller than the rig's largest backlash (" +
                        number(backlash) +

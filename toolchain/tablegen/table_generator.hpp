@@ -26,6 +26,9 @@ struct GeneratorOptions {
   std::uint64_t seed = 1;
   PlacementOptions placement;
   double allowance_mm = 0.0;
+  // The largest backlash of the rig the tables are for (the caller's: the program's is the rig's,
+  // rig_defaults.hpp): an allowance below it is warned about. 0: no rig, no warning.
+  double rig_largest_backlash_mm = 0.0;
   unsigned threads = 1;
 };
 

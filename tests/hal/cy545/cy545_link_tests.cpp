@@ -14,6 +14,8 @@
 #include <mutex>
 #include <thread>
 
+#include "board/sim/sim_facts.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"
@@ -33,12 +35,13 @@ using stencil::sim::StepDirection;
 namespace {
 
 constexpr MonotonicNs kMs = 1'000'000;
+constexpr std::uint32_t kBaud = stencil::board::sim::kBaud;  // the rig's line, as the simulation runs it
 
 Cy545Config fast_homing_config() {
-  Cy545Config config;
-  config.homing_rate = 20000;        // quick in tests
-  config.homing_slow_rate = 5000;
-  config.homing_travel_steps = 2000;  // the test puts every axis within 200 steps of its switch
+  Cy545Config config = stencil::board::sherline_suzuki::kCy545;
+  config.motion.homing_rate = 20000;        // quick in tests
+  config.motion.homing_slow_rate = 5000;
+  config.motion.homing_travel_steps = 2000;  // the test puts every axis within 200 steps of its switch
   // The fake is a thread on a host that is not real-time, and CI runs it under the sanitizers beside
   // other tests: a second (250 ms was once missed there, ASan at a load of 6 on 2 cores).
   config.reply_timeout_ns = 1000 * kMs;
@@ -48,9 +51,9 @@ Cy545Config fast_homing_config() {
 // The simulated mill with every axis a little above its home switch, the fake CY545 on a pty
 // serviced in real time, and the driver on the pty's other end.
 struct Bench {
-  sim::SimulatedMill mill{sim::sherline_mill_config()};
+  sim::SimulatedMill mill{stencil::board::sim::kMillConfig};
   bool placed = place_near_home(mill);
-  sim::cy545::FakeCy545 fake{mill, hal::posix_clock::monotonic_now_ns()};
+  sim::cy545::FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, hal::posix_clock::monotonic_now_ns()};
   posix_clock::MonotonicClock clock;
   SerialPort port;
   bool opened = open(port, fake.slave_path());
@@ -67,7 +70,7 @@ struct Bench {
   }
   static bool open(SerialPort& port, const std::string& path) {
     char error[256] = {};
-    CHECK_TEXT(port.open(path.c_str(), error), error);
+    CHECK_TEXT(port.open(path.c_str(), kBaud, error), error);
     return true;
   }
   MonotonicNs in(MonotonicNs ns) const { return clock.now_ns() + ns; }
@@ -218,16 +221,16 @@ TEST(Cy545Link, StartUpGivesUpWhenTheControllerNeverAnswers) {
 TEST(Cy545Link, APathThatIsNotASerialPortIsRefusedByName) {
   SerialPort port;
   char error[256] = {};
-  CHECK_FALSE(port.open("/dev/null", error));
+  CHECK_FALSE(port.open("/dev/null", kBaud, error));
   STRCMP_CONTAINS("/dev/null: not a serial port", error);
   char file[] = "/tmp/stencil-not-a-tty-XXXXXX";
   const int fd = mkstemp(file);
   CHECK(fd >= 0);
   close(fd);
-  CHECK_FALSE(port.open(file, error));
+  CHECK_FALSE(port.open(file, kBaud, error));
   STRCMP_CONTAINS("not a serial port", error);
   unlink(file);
-  CHECK_FALSE(port.open("/dev/no-such-port", error));
+  CHECK_FALSE(port.open("/dev/no-such-port", kBaud, error));
   STRCMP_CONTAINS("/dev/no-such-port: cannot open", error);
 }
 
@@ -239,10 +242,10 @@ TEST(Cy545Link, OneUpdateIsExactlyTheseBytes) {
   CHECK(grantpt(master) == 0 && unlockpt(master) == 0);
   SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(ptsname(master), error), error);
+  CHECK_TEXT(port.open(ptsname(master), kBaud, error), error);
   CHECK_FALSE(port.has_modem_lines());
   posix_clock::MonotonicClock clock;
-  Cy545Link link(port, clock, Cy545Config{});
+  Cy545Link link(port, clock, stencil::board::sherline_suzuki::kCy545);
   CHECK(link.declare_home(clock.now_ns() + 100 * kMs).refusal == MachineRefusal::NotHomed);  // not started
   std::string recorded;
   std::mutex recorded_mutex;
@@ -406,14 +409,14 @@ namespace {
 // The same chain on virtual time (the fast simulation's FakeCy545Clock): deterministic, and a
 // homing of tens of seconds takes a fraction of one here.
 struct VirtualBench {
-  sim::SimulatedMill mill{sim::sherline_mill_config()};  // every axis mid-travel, as at power-up
-  sim::cy545::FakeCy545 fake{mill, 0};
-  sim::cy545::FakeCy545Clock clock{fake, 0, 57600.0};
+  sim::SimulatedMill mill{stencil::board::sim::kMillConfig};  // every axis mid-travel, as at power-up
+  sim::cy545::FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, 0};
+  sim::cy545::FakeCy545Clock clock{fake, 0, kBaud};
   SerialPort port;
   bool opened = Bench::open(port, fake.slave_path());
   Cy545Link link;
 
-  explicit VirtualBench(const Cy545Config& config = Cy545Config{}) : link(port, clock, config) {}
+  explicit VirtualBench(const Cy545Config& config = stencil::board::sherline_suzuki::kCy545) : link(port, clock, config) {}
 
   // As the rig does: wake-up and spindle in seconds, homing as long as the link says it can take.
   MachineResult start_and_home() {
@@ -453,14 +456,14 @@ TEST(Cy545Link, InvertedHomeSwitchWiringIsAFaultAfterAtMostTheSwitchZone) {
   CHECK_FALSE(homed.done);
   CHECK(homed.fault == MachineFault::PositionMismatch);
   STRCMP_CONTAINS("homing axis Z: its home switch still reads closed", bench.link.last_error());
-  const Cy545Config defaults;
-  CHECK(bench.mill.axis_position_steps(Axis::z) - z_before <= defaults.home_switch_zone_steps + defaults.homing_chunk_steps);
-  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::x) - sim::sherline_mill_config().axes[0].initial_position_steps);
+  const Cy545Config defaults = stencil::board::sherline_suzuki::kCy545;
+  CHECK(bench.mill.axis_position_steps(Axis::z) - z_before <= defaults.motion.home_switch_zone_steps + defaults.motion.homing_chunk_steps);
+  CHECK_EQUAL(0, bench.mill.axis_position_steps(Axis::x) - stencil::board::sim::kMillConfig.axes[0].initial_position_steps);
 }
 
 TEST(Cy545Link, TheConfiguredClosedLevelHomesInvertedWiring) {
-  Cy545Config config;
-  config.home_switch_closed_level = {false, false, false};
+  Cy545Config config = stencil::board::sherline_suzuki::kCy545;
+  config.wiring.home_switch_closed_level = {false, false, false};
   VirtualBench bench(config);
   bench.fake.board().set_home_switches_inverted(true);
   CHECK_TEXT(bench.start_and_home().done, bench.link.last_error());
@@ -534,7 +537,7 @@ TEST(Cy545Link, OnABoardThatLatchesEachChannelLineOnlyTheAxisCommandedMoves) {
 // chip's three-character buffer on virtual time, where bytes take their wire time and commands the
 // chip's: start-up's commands already arrive while the chip still takes the one before.
 TEST(Cy545Link, WithoutTheSettleBetweenCommandsTheChipLosesBytes) {
-  Cy545Config config;
+  Cy545Config config = stencil::board::sherline_suzuki::kCy545;
   config.command_settle_ns = 0;
   VirtualBench bench(config);
   const MachineResult started = bench.link.start(bench.clock.now_ns() + 300 * kMs);

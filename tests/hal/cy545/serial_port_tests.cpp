@@ -17,6 +17,7 @@
 #include <cstring>
 #include <string>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/cy545/serial_port.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -43,6 +44,9 @@ struct Pty {
   ~Pty() { ::close(master_fd); }
   const char* path() const { return slave_path.c_str(); }
 };
+
+// The rig's line (57600 8N1): the port is opened at it.
+constexpr std::uint32_t kBaud = stencil::board::sherline_suzuki::kRig.serial_baud;
 
 // Exit codes of the unprivileged child below that are not an errno.
 constexpr int kOpened = 0;
@@ -94,10 +98,10 @@ TEST(SerialPort, ASecondOpenOfAHeldPortIsRefusedNamingThePath) {
   Pty pty;
   SerialPort first;
   char error[256] = {};
-  CHECK_TEXT(first.open(pty.path(), error), error);
+  CHECK_TEXT(first.open(pty.path(), kBaud, error), error);
 
   SerialPort second;
-  CHECK_FALSE_TEXT(second.open(pty.path(), error), "a second rig opened a port the first one holds");
+  CHECK_FALSE_TEXT(second.open(pty.path(), kBaud, error), "a second rig opened a port the first one holds");
   CHECK_FALSE(second.is_open());
   STRCMP_CONTAINS(pty.path(), error);
   CHECK_TEXT(held_by_another_program(error), error);
@@ -113,13 +117,13 @@ TEST(SerialPort, APortLockedByAnotherProgramIsRefusedEvenAsRoot) {
 
   SerialPort port;
   char error[256] = {};
-  CHECK_FALSE_TEXT(port.open(pty.path(), error), "opened a port another program holds locked");
+  CHECK_FALSE_TEXT(port.open(pty.path(), kBaud, error), "opened a port another program holds locked");
   STRCMP_CONTAINS(pty.path(), error);
   CHECK_TEXT(held_by_another_program(error), error);
   STRCMP_CONTAINS("locked", error);
 
   ::close(other);
-  CHECK_TEXT(port.open(pty.path(), error), error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 }
 
 TEST(SerialPort, APortAnotherProgramHoldsExclusivelyIsRefusedEvenAsRoot) {
@@ -132,7 +136,7 @@ TEST(SerialPort, APortAnotherProgramHoldsExclusivelyIsRefusedEvenAsRoot) {
 
   SerialPort port;
   char error[256] = {};
-  CHECK_FALSE_TEXT(port.open(pty.path(), error), "opened a port another program holds exclusively");
+  CHECK_FALSE_TEXT(port.open(pty.path(), kBaud, error), "opened a port another program holds exclusively");
   STRCMP_CONTAINS(pty.path(), error);
   CHECK_TEXT(held_by_another_program(error), error);
   STRCMP_CONTAINS("exclusive", error);
@@ -142,7 +146,7 @@ TEST(SerialPort, APortAnotherProgramHoldsExclusivelyIsRefusedEvenAsRoot) {
 
   CHECK(ioctl(other, TIOCNXCL) == 0);
   ::close(other);
-  CHECK_TEXT(port.open(pty.path(), error), error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 }
 
 TEST(SerialPort, APortOpensAgainOnceItsHolderClosesIt) {
@@ -150,12 +154,12 @@ TEST(SerialPort, APortOpensAgainOnceItsHolderClosesIt) {
   SerialPort first;
   SerialPort second;
   char error[256] = {};
-  CHECK_TEXT(first.open(pty.path(), error), error);
-  CHECK_FALSE_TEXT(second.open(pty.path(), error), "a second rig opened a port the first one holds");
+  CHECK_TEXT(first.open(pty.path(), kBaud, error), error);
+  CHECK_FALSE_TEXT(second.open(pty.path(), kBaud, error), "a second rig opened a port the first one holds");
 
   first.close();
   CHECK_FALSE(first.is_open());
-  CHECK_TEXT(second.open(pty.path(), error), error);
+  CHECK_TEXT(second.open(pty.path(), kBaud, error), error);
   second.close();
 
   // The exclusive flag lives on the tty, not the descriptor: a pseudo-terminal (or a port some
@@ -179,7 +183,7 @@ TEST(SerialPort, AnotherProgramsPlainOpenIsRefusedWithEbusyWhileThePortIsHeld) {
   Pty pty;
   SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(pty.path(), error), error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 
   const int plain = plain_open_errno(pty.path());
   if (plain < 0) {
@@ -196,8 +200,8 @@ TEST(SerialPort, ARefusedOpenLeavesTheHolderExclusive) {
   SerialPort first;
   SerialPort second;
   char error[256] = {};
-  CHECK_TEXT(first.open(pty.path(), error), error);
-  CHECK_FALSE(second.open(pty.path(), error));
+  CHECK_TEXT(first.open(pty.path(), kBaud, error), error);
+  CHECK_FALSE(second.open(pty.path(), kBaud, error));
   second.close();
 
   const int plain = plain_open_errno(pty.path());
@@ -222,7 +226,7 @@ TEST(SerialPort, HangUpOnCloseIsClearSoTheModemLinesStayUp) {
 
   SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(pty.path(), error), error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 
   CHECK(tcgetattr(pty.master_fd, &settings) == 0);
   CHECK_EQUAL(0u, settings.c_cflag & HUPCL);
@@ -246,8 +250,20 @@ TEST(SerialPort, HardwareFlowControlIsOffWhateverTheLastProgramLeft) {
 
   SerialPort port;
   char error[256] = {};
-  CHECK_TEXT(port.open(pty.path(), error), error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 
   CHECK(tcgetattr(pty.master_fd, &settings) == 0);
   CHECK_EQUAL(0u, settings.c_cflag & CRTSCTS);
+}
+
+// The baud rate is the board's (the rig's facts): one the port does not offer is refused by name,
+// before the port is touched.
+TEST(SerialPort, ABaudRateThePortDoesNotOfferIsRefused) {
+  Pty pty;
+  SerialPort port;
+  char error[256] = {};
+  CHECK_FALSE(port.open(pty.path(), 12345, error));
+  CHECK_FALSE(port.is_open());
+  STRCMP_CONTAINS("12345 baud: expected 9600, 19200, 38400, 57600 or 115200", error);
+  CHECK_TEXT(port.open(pty.path(), kBaud, error), error);
 }

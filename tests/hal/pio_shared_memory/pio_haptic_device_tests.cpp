@@ -9,6 +9,7 @@
 #include <thread>
 #include <vector>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/haptic_range_checks.hpp"
 #include "hal/pio_shared_memory/pio_device_side.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
@@ -97,7 +98,7 @@ TEST_GROUP(PioHapticDevice) {
     device_link = std::make_unique<sim::PioDeviceLink>(windows.device->window());
     device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, counter_pose);
     test::open_host_window(windows);
-    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
+    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   }
 
   // One millisecond as the rig runs it: the device's cycle, then the host's (read, then write).
@@ -120,7 +121,7 @@ TEST_GROUP(PioHapticDevice) {
     host.reset();
     test::open_host_window(windows);
     CHECK_TRUE(windows.host != nullptr);
-    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
+    host = std::make_unique<pio::PioHapticDevice>(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   }
 };
 
@@ -330,7 +331,7 @@ TEST(PioHapticDevice, TheHostHeartbeatMovesWithEveryWriteAndContinuesAfterAResta
     CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 0.0, false)).status);
     CHECK_EQUAL(static_cast<std::uint32_t>(write), windows.device->window().command.host_heartbeat);
   }
-  pio::PioHapticDevice restarted(&windows.host->window(), hal::kDefaultHapticRange);
+  pio::PioHapticDevice restarted(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   CHECK_EQUAL(WriteStatus::Written, restarted.write_command(command_of(0.0, 0.0, 0.0, false)).status);
   CHECK_EQUAL(4U, windows.device->window().command.host_heartbeat);
 }
@@ -483,7 +484,7 @@ TEST(PioHapticDevice, AfterATripForceWaitsForClearFaultEvenWhenTheLatchHoldsAnEa
 }
 
 TEST(PioHapticDevice, ABackendWithoutAWindowReportsNotOpenAndLatchesIt) {
-  pio::PioHapticDevice closed(nullptr, hal::kDefaultHapticRange);
+  pio::PioHapticDevice closed(nullptr, stencil::board::sherline_suzuki::kCentredDeviceRange);
   CHECK_EQUAL(hal::HapticLinkState::Closed, closed.link_state());
   hal::HapticSample sample{};
   const hal::ReadResult read = closed.read_sample(0, sample);
@@ -495,7 +496,7 @@ TEST(PioHapticDevice, ABackendWithoutAWindowReportsNotOpenAndLatchesIt) {
 
 TEST(PioHapticDevice, NeverAcceptsATornSampleWhileTheSimulatedDeviceWritesAt1kHz) {
   // A watchdog far beyond any scheduling hiccup: this test is about consistency, not timing.
-  pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
+  pio::PioHapticDevice reader(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange, 10'000'000'000);
   sim::SimulatedDeviceThread device_thread(*device);
   const hal::MonotonicNs end = hal::posix_clock::monotonic_now_ns() + 300 * kMs;
   int reads = 0;
@@ -530,7 +531,7 @@ TEST(PioHapticDevice, NeverAcceptsATornSampleFromAWriterHammeringTheWindow) {
       writer_side.publish_pose(pio::PoseWords{k, {value, -value, value / 2}, {value, -value}, k, k});
     }
   });
-  pio::PioHapticDevice reader(&windows.host->window(), hal::kDefaultHapticRange, 10'000'000'000);
+  pio::PioHapticDevice reader(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange, 10'000'000'000);
   int fresh = 0;
   int inconsistent = 0;
   const hal::MonotonicNs end = hal::posix_clock::monotonic_now_ns() + 5'000 * kMs;
@@ -589,7 +590,7 @@ TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPa
     sample.position_mm[0] = x;
     sample.position_mm[1] = y;
     sample.position_mm[2] = z;
-    return hal::sample_in_range(sample, hal::kCornerOriginHapticRange);
+    return hal::sample_in_range(sample, stencil::board::sherline_suzuki::kDeviceRange);
   };
   CHECK_TRUE(at(0.0, 0.0, 0.0));
   CHECK_TRUE(at(500.0, 250.0, 250.0));
@@ -597,7 +598,7 @@ TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPa
   CHECK_FALSE(at(525.001, 0.0, 0.0));
   CHECK_FALSE(at(0.0, -25.001, 0.0));
   CHECK_FALSE(at(0.0, 0.0, NAN));
-  CHECK_FALSE(hal::sample_in_range(sample, hal::kDefaultHapticRange));  // the centred reach says no to z NaN too
+  CHECK_FALSE(hal::sample_in_range(sample, stencil::board::sherline_suzuki::kCentredDeviceRange));  // the centred reach says no to z NaN too
   CHECK_TRUE(at(250.0, 125.0, 125.0));
   CHECK_FALSE(hal::sample_in_range(sample, hal::HapticRange{{1.0, 1.0, 1.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}}));
 }

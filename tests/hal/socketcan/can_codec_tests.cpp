@@ -2,6 +2,7 @@
 // of bad frame refused, counted and never applied, on both sides.
 #include <cstring>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/socketcan/can_codec.hpp"
 #include "tests/hal/socketcan/can_strings.hpp"
 
@@ -94,7 +95,7 @@ TEST(CanCodec, EncodingRefusesAPositionBeyond24Bits) {
 }
 
 TEST(CanCodec, StatusRoundTripsAtTheLimitsOfItsFields) {
-  HostFrameAssembler host(kDefaultHapticRange);
+  HostFrameAssembler host(stencil::board::sherline_suzuki::kCentredDeviceRange);
   for (const StatusWire& status : {StatusWire{255, 0xFFFF, 0xFFFFFFFFU}, StatusWire{0, 0, 0}}) {
     can_frame frame;
     encode_status(status, frame);
@@ -106,7 +107,7 @@ TEST(CanCodec, StatusRoundTripsAtTheLimitsOfItsFields) {
 }
 
 TEST(CanCodec, APoseAtTheRangeLimitIsAcceptedAndOneStepBeyondIsRefused) {
-  HostFrameAssembler host(kDefaultHapticRange);  // 275 x 150 x 150 mm, 3.2 rad
+  HostFrameAssembler host(stencil::board::sherline_suzuki::kCentredDeviceRange);  // 275 x 150 x 150 mm, 3.2 rad
   can_frame pose_a;
   can_frame pose_b;
   CHECK_TRUE(encode_pose(PoseWire{1, {275000, -150000, 150000}, {32000, -32000}}, pose_a, pose_b));
@@ -128,7 +129,7 @@ TEST(CanCodec, APoseAtTheRangeLimitIsAcceptedAndOneStepBeyondIsRefused) {
 }
 
 TEST(CanCodec, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPastItsMargin) {
-  HostFrameAssembler host(kCornerOriginHapticRange);  // [0, 500] x [0, 250] x [0, 250] mm, 25 mm margin
+  HostFrameAssembler host(stencil::board::sherline_suzuki::kDeviceRange);  // [0, 500] x [0, 250] x [0, 250] mm, 25 mm margin
   can_frame pose_a;
   can_frame pose_b;
   CHECK_TRUE(encode_pose(PoseWire{1, {500000, 250000, 0}, {0, 0}}, pose_a, pose_b));
@@ -164,7 +165,7 @@ TEST(CanCodec, CommandRoundTripsAtTheDevicesLimits) {
 }
 
 TEST(CanCodec, TheHostRefusesAndCountsEveryKindOfBadFrameAndAppliesNone) {
-  HostFrameAssembler host(kDefaultHapticRange);
+  HostFrameAssembler host(stencil::board::sherline_suzuki::kCentredDeviceRange);
   can_frame good_a;
   can_frame good_b;
   CHECK_TRUE(encode_pose(PoseWire{1, {1000, 2000, 3000}, {10, 20}}, good_a, good_b));

@@ -14,6 +14,7 @@
 
 #include <linux/can/error.h>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/socketcan/can_error_frames.hpp"
 #include "hal/socketcan/fd_can_channel.hpp"
 #include "hal/socketcan/socketcan_haptic_device.hpp"
@@ -62,7 +63,7 @@ TEST_GROUP(SocketCanHapticDevice) {
     device_channel = std::make_unique<can::FdCanChannel>(fds[1]);
     device_link = std::make_unique<sim::CanDeviceLink>(*device_channel);
     device = std::make_unique<sim::SimulatedHapticDevice>(*device_link, test::counter_pose);
-    host = std::make_unique<can::SocketCanHapticDevice>(host_channel.get(), hal::kDefaultHapticRange);
+    host = std::make_unique<can::SocketCanHapticDevice>(host_channel.get(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   }
 
   void inject(const can_frame& frame) { CHECK_EQUAL(can::TransferStatus::Done, device_channel->send(frame)); }
@@ -325,7 +326,7 @@ TEST(SocketCanHapticDevice, AClosedPeerIsATransportFault) {
 }
 
 TEST(SocketCanHapticDevice, ABackendWithoutAChannelReportsNotOpen) {
-  can::SocketCanHapticDevice closed(nullptr, hal::kDefaultHapticRange);
+  can::SocketCanHapticDevice closed(nullptr, stencil::board::sherline_suzuki::kCentredDeviceRange);
   CHECK_EQUAL(hal::HapticLinkState::Closed, closed.link_state());
   hal::HapticSample sample{};
   CHECK_EQUAL(HapticFault::NotOpen, closed.read_sample(0, sample).reason);
@@ -376,7 +377,7 @@ TEST(SocketCanOnVcan0, PosesAndCommandsCrossARealCanInterface) {
   can::FdCanChannel device_channel(device_fd);
   sim::CanDeviceLink device_link(device_channel);
   sim::SimulatedHapticDevice device(device_link, test::counter_pose);
-  can::SocketCanHapticDevice host(&host_channel, hal::kDefaultHapticRange);
+  can::SocketCanHapticDevice host(&host_channel, stencil::board::sherline_suzuki::kCentredDeviceRange);
 
   hal::HapticSample sample{};
   device.step(1 * kMs);

@@ -6,6 +6,7 @@
 #include <string>
 #include <string_view>
 
+#include "board/sim/sim_facts.hpp"
 #include "sim/cy545/fake_cy545.hpp"
 #include "sim/mill/simulated_mill.hpp"
 #include "tests/sim/cy545/pty_test_client.hpp"
@@ -15,8 +16,8 @@ namespace stencil::sim::cy545::test {
 inline constexpr hal::MonotonicNs kMs = 1'000'000;
 
 struct FakeCy545Bench {
-  SimulatedMill mill{sherline_mill_config()};
-  FakeCy545 fake{mill, 0};
+  SimulatedMill mill{stencil::board::sim::kMillConfig};
+  FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, 0};
   PtyTestClient client{fake.slave_path()};
   // These tests spell out the address-latching board (cy545_protocol.hpp); the per-line one has its own.
   bool latching = [this] {

@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <thread>
 
+#include "board/sim/sim_facts.hpp"
 #include "sim/cy545/fake_cy545_runner.hpp"
 #include "tests/sim/cy545/pty_test_client.hpp"
 
@@ -14,11 +15,11 @@ using namespace stencil::sim::cy545;
 using namespace stencil::sim::cy545::test;
 
 TEST_GROUP(FakeCy545Runner) {
-  SimulatedMill mill{sherline_mill_config()};
+  SimulatedMill mill{stencil::board::sim::kMillConfig};
 };
 
 TEST(FakeCy545Runner, AnswersQueriesWithoutTheTestSteppingIt) {
-  FakeCy545 fake{mill, stencil::hal::posix_clock::monotonic_now_ns()};
+  FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, stencil::hal::posix_clock::monotonic_now_ns()};
   FakeCy545Runner runner{fake};
   PtyTestClient client{fake.slave_path()};
   CHECK_TRUE(client.write_raw("\rN 10\r? N\r"));
@@ -26,7 +27,7 @@ TEST(FakeCy545Runner, AnswersQueriesWithoutTheTestSteppingIt) {
 }
 
 TEST(FakeCy545Runner, AMoveTakesAtLeastItsStepsOverRateOfWallTime) {
-  FakeCy545 fake{mill, stencil::hal::posix_clock::monotonic_now_ns()};
+  FakeCy545 fake{mill, stencil::board::sim::kMmc4sWiring, stencil::hal::posix_clock::monotonic_now_ns()};
   FakeCy545Runner runner{fake};
   PtyTestClient client{fake.slave_path()};
   const std::int64_t x0 = mill.axis_position_steps(Axis::x);

@@ -1,5 +1,6 @@
 // The simulated CAN bus: wire time at the bitrate, arbitration by identifier, bounded queues that drop
 // and count, error frames and bus-off; and the haptic exchange over it at 500 kbit/s and at 1 Mbit/s.
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "sim/haptic_device/simulated_can_bus.hpp"
 
 #include <linux/can/error.h>
@@ -51,7 +52,7 @@ struct HapticBus {
   sim::SimulatedCanBus bus;
   sim::CanDeviceLink link{bus.device()};
   sim::SimulatedHapticDevice device{link, test::counter_pose};
-  can::SocketCanHapticDevice host{&bus.host(), hal::kDefaultHapticRange};
+  can::SocketCanHapticDevice host{&bus.host(), stencil::board::sherline_suzuki::kCentredDeviceRange};
 
   explicit HapticBus(const sim::CanBusConfig& config) : bus(clock, config) {}
 

@@ -10,6 +10,7 @@
 #include <memory>
 #include <thread>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/seqlock.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
@@ -72,7 +73,7 @@ struct PioRig final : Rig {
     windows.host.reset();
     test::open_host_window(windows);
     CHECK_TRUE(windows.host != nullptr);
-    backend = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&windows.host->window(), hal::kDefaultHapticRange);
+    backend = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   }
 };
 
@@ -87,7 +88,7 @@ struct CanRig final : Rig {
   hal::socketcan::FdCanChannel device_channel{sockets.fds[1]};
   sim::CanDeviceLink link{device_channel};
   sim::SimulatedHapticDevice simulated{link, test::counter_pose};
-  hal::socketcan::SocketCanHapticDevice backend{&host_channel, hal::kDefaultHapticRange};
+  hal::socketcan::SocketCanHapticDevice backend{&host_channel, stencil::board::sherline_suzuki::kCentredDeviceRange};
   std::uint16_t plain_heartbeat = 0;
   hal::HapticDevice& host() override { return backend; }
   sim::SimulatedHapticDevice& device() override { return simulated; }

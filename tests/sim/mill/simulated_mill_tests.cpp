@@ -1,5 +1,6 @@
 // The simulated mill: backlash taken up exactly on reversal, home switch edge, hard stops, drivers, spindle.
-#include "board/sherline_suzuki/rig_constants.hpp"
+#include "board/sherline_suzuki/rig_facts.hpp"
+#include "board/sim/sim_facts.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -19,12 +20,13 @@ StepOutcome step_n(SimulatedMill& mill, Axis axis, StepDirection direction, int 
 }  // namespace
 
 TEST_GROUP(SimulatedMill) {
-  SimulatedMill mill{sherline_mill_config()};
+  SimulatedMill mill{stencil::board::sim::kMillConfig};
   void setup() override { mill.set_drivers_enabled(true); }
 };
 
-TEST(SimulatedMill, ConfigComesFromTheRigConstants) {
-  const MillConfig config = sherline_mill_config();
+// The simulation board's mill (board/sim/sim_facts.hpp) is the rig's, in motor steps.
+TEST(SimulatedMill, TheSimulationBoardsMillComesFromTheRigFacts) {
+  const MillConfig config = stencil::board::sim::kMillConfig;
   LONGS_EQUAL(80, config.axes[0].backlash_steps);
   LONGS_EQUAL(32, config.axes[1].backlash_steps);
   LONGS_EQUAL(80, config.axes[2].backlash_steps);
@@ -123,7 +125,7 @@ TEST(SimulatedMill, DisabledDriversIgnoreSteps) {
 }
 
 TEST(SimulatedMill, PowersUpWithDriversOffSpindleOffInMidWorkspace) {
-  SimulatedMill fresh{sherline_mill_config()};
+  SimulatedMill fresh{stencil::board::sim::kMillConfig};
   CHECK_FALSE(fresh.drivers_enabled());
   CHECK_FALSE(fresh.spindle_on());
   LONGS_EQUAL(25 * 640, fresh.axis_position_steps(Axis::x));

@@ -1,0 +1,193 @@
+// The Sherline mill + Suzuki 5-DOF device rig: every fact of it, once (the thesis, table 6-1, and the
+// wiring of its MMC-4S board), and what follows from them. Nothing else types these numbers: the rig's
+// job and program take them from here, board/sim derives the simulation's from them, and sim/, hal/
+// and the table generator are handed what they need as parameters.
+#pragma once
+
+#include <array>
+#include <cstdint>
+
+#include "firmware/core/motion/machine_planner.hpp"
+#include "hal/clock.hpp"
+#include "hal/cy545/cy545_link.hpp"
+#include "hal/haptic_device.hpp"
+
+namespace stencil::board::sherline_suzuki {
+
+// Every per-axis array is x y z. Machine coordinates per axis: 0 at the home switch's edge, + along
+// the machine's + axis (X and Y: the table's own displacement, Z: the head's), workspace [0, workspace_mm].
+struct RigFacts {
+  // ---- The mill (Sherline 3-axis) and its motion controller (CY545 on an MMC-4S board, RS-232).
+  std::array<double, 3> workspace_mm;       // machine workspace: the box [0,X]x[0,Y]x[0,Z]
+  // World to machine, per axis: +1 counts along the world axis, -1 against it. X and Y move the table
+  // (the work moves under the tool) and every axis counts into the workspace from its switch: all -1.
+  std::array<int, 3> machine_sign;
+  double steps_per_mm;                      // motor resolution, every axis (16000 steps/inch)
+  double max_speed_mm_per_s;                // per axis
+  double step_rate_steps_per_s;             // the CY545's R and F: all axes together, one at a time
+  std::array<double, 3> backlash_mm;
+  double machine_update_hz;                 // the CY545 link's updates
+  std::uint32_t serial_baud;                // the CY545's RS-232 line, 8N1
+  // How far each axis can travel past the workspace: below 0 is the home switch's closed zone down to
+  // the low hard stop, above the workspace a margin up to the high hard stop.
+  double home_overtravel_mm;
+  double far_overtravel_mm;
+  double home_switch_edge_mm;               // the switch is closed below this machine coordinate, open at and above
+  hal::cy545::Mmc4sWiring mmc4s;            // output-mux, input-mux and relay wiring, switch levels, latching
+  // Homing (the CY545 driver's legs, hal/cy545): its rates, how far a leg may run into the switch, the
+  // slack the departure may turn before the axis moves, the longest approach, the switch's closed zone.
+  double homing_speed_mm_per_s;             // under max_speed_mm_per_s
+  double homing_slow_speed_mm_per_s;        // the last, edge-finding steps
+  double homing_chunk_mm;
+  double homing_slack_mm;                   // above the largest backlash
+  double homing_travel_mm;                  // more than the whole travel
+  double home_switch_zone_mm;               // more than home_overtravel_mm: a switch closed this far out is miswired
+  // The hardware watchdog relay in the spindle's and drivers' power: it opens when the heartbeat output
+  // has not changed for this long (the driver toggles it every heartbeat period / 2).
+  hal::MonotonicNs watchdog_relay_timeout_ns;
+
+  // ---- The haptic device (Suzuki 5-DOF) and the cycle.
+  std::array<double, 3> haptic_workspace_mm;  // the device's reach; its origin at a corner in the programs' frame
+  double device_reach_margin_mm;            // a sample this far outside the reach is still a sample
+  double haptic_to_machine_scale;           // device millimetres per machine (world) millimetre
+  double force_limit_n;                     // the operator can always overpower this
+  double torque_limit_nmm;                  // the two displayed torques, in magnitude
+  double angle_limit_rad;                   // the two sensed angles, in magnitude
+  double haptic_rate_hz;                    // the cycle
+
+  // ---- The controller on this rig.
+  // The virtual tool is held to what the mill follows over the serial line: 1.4 mm/s per axis and
+  // 1000 steps/s are its stepping, but each update also spends about 15 ms of its 33 on the serial
+  // line, so 1 mm/s per axis and in |dx| + |dy| + |dz|.
+  double virtual_tool_speed_mm_per_s;
+  double stock_model_cell_mm;               // the controller's model of the machined stock
+  int overrun_limit;                        // more overruns in a row than this: a safe state
+  int stale_periods;                        // more periods than this without a fresh sample: a safe state
+  bool start_held;                          // the cycle starts held until the hand is held still near the tool
+};
+
+inline constexpr RigFacts kRig{
+    .workspace_mm = {50.0, 25.0, 25.0},
+    .machine_sign = {-1, -1, -1},
+    .steps_per_mm = 640.0,
+    .max_speed_mm_per_s = 1.4,
+    .step_rate_steps_per_s = 1000.0,
+    .backlash_mm = {0.125, 0.05, 0.125},
+    .machine_update_hz = 30.0,
+    .serial_baud = 57600,
+    .home_overtravel_mm = 3.0,
+    .far_overtravel_mm = 5.0,
+    .home_switch_edge_mm = 0.0,
+    .mmc4s = {.motor_channel = {0, 1, 2},
+              .home_input = {0, 1, 2},
+              .spindle_output = 4,
+              .heartbeat_output = 5,
+              .heartbeat_period_ns = 400'000'000,  // the relay drops after about 1 s without a change
+              .home_switch_closed_level = {true, true, true},
+              .channel_lines_latch_data = true},
+    .homing_speed_mm_per_s = 1.25,
+    .homing_slow_speed_mm_per_s = 0.3125,
+    .homing_chunk_mm = 0.1,
+    .homing_slack_mm = 0.4,
+    .homing_travel_mm = 64.0,
+    .home_switch_zone_mm = 4.0,
+    .watchdog_relay_timeout_ns = 1'000'000'000,
+    .haptic_workspace_mm = {500.0, 250.0, 250.0},
+    .device_reach_margin_mm = 25.0,
+    .haptic_to_machine_scale = 10.0,
+    .force_limit_n = 5.0,
+    .torque_limit_nmm = 200.0,
+    .angle_limit_rad = 3.2,
+    .haptic_rate_hz = 1000.0,
+    .virtual_tool_speed_mm_per_s = 1.0,
+    .stock_model_cell_mm = 0.05,
+    .overrun_limit = 3,
+    .stale_periods = 5,
+    .start_held = true,
+};
+
+// ---- What follows from the facts.
+
+inline constexpr int kAxisCount = 3;
+
+// The cycle's period and the machine's update, in nanoseconds (1 ms; 33.3 ms, truncated).
+inline constexpr hal::MonotonicNs kPeriodNs = static_cast<hal::MonotonicNs>(1e9 / kRig.haptic_rate_hz);
+inline constexpr hal::MonotonicNs kUpdateNs = static_cast<hal::MonotonicNs>(1e9 / kRig.machine_update_hz);
+static_assert(kPeriodNs == 1'000'000 && kUpdateNs == 1'000'000'000 / 30);
+
+// Where the tool tip is in the world with the machine at home, before any touch-off: the workspace's
+// far top corner (X and Y's switches at the table's travel end, Z's at the top), so that every axis
+// counts from there into the workspace (machine_sign).
+inline constexpr std::array<double, 3> kHomeWorldMm = kRig.workspace_mm;
+
+inline constexpr double largest_backlash_mm() {
+  double largest = 0.0;
+  for (const double backlash : kRig.backlash_mm) {
+    largest = backlash > largest ? backlash : largest;
+  }
+  return largest;
+}
+
+inline constexpr double travel_min_mm(int axis) {
+  static_cast<void>(axis);
+  return kRig.home_switch_edge_mm - kRig.home_overtravel_mm;
+}
+inline constexpr double travel_max_mm(int axis) {
+  return kRig.workspace_mm[static_cast<std::size_t>(axis)] + kRig.far_overtravel_mm;
+}
+
+// Millimetres to whole motor steps, rounded to nearest (every value used here is a whole number).
+inline constexpr long long mm_to_steps(double mm) {
+  const double steps = mm * kRig.steps_per_mm;
+  return static_cast<long long>(steps < 0.0 ? steps - 0.5 : steps + 0.5);
+}
+
+// Backlash per axis in motor steps: 80, 32, 80.
+inline constexpr long long backlash_steps(int axis) { return mm_to_steps(kRig.backlash_mm[static_cast<std::size_t>(axis)]); }
+static_assert(backlash_steps(0) == 80 && backlash_steps(1) == 32 && backlash_steps(2) == 80,
+              "backlash must be a whole number of steps");
+
+// What the machine side's planner may spend: the mill's speed, one update, the backlash to take up.
+inline constexpr motion::PlannerLimits kPlannerLimits{
+    {kRig.max_speed_mm_per_s, kRig.step_rate_steps_per_s, kRig.steps_per_mm},
+    1.0 / kRig.machine_update_hz,
+    {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
+     static_cast<std::int32_t>(backlash_steps(2))}};
+
+// The CY545 driver's configuration on this rig: its wiring, and its rates and homing in motor steps.
+inline constexpr hal::cy545::Cy545Motion kCy545Motion{
+    .step_rate = static_cast<std::uint32_t>(kRig.step_rate_steps_per_s),
+    .update_period_s = 1.0 / kRig.machine_update_hz,
+    .homing_rate = static_cast<std::uint32_t>(mm_to_steps(kRig.homing_speed_mm_per_s)),
+    .homing_slow_rate = static_cast<std::uint32_t>(mm_to_steps(kRig.homing_slow_speed_mm_per_s)),
+    .homing_chunk_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_chunk_mm)),
+    .homing_slack_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_slack_mm)),
+    .homing_travel_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_travel_mm)),
+    .home_switch_zone_steps = static_cast<std::int32_t>(mm_to_steps(kRig.home_switch_zone_mm)),
+};
+static_assert(kCy545Motion.homing_rate == 800 && kCy545Motion.homing_slow_rate == 200 &&
+              kCy545Motion.homing_chunk_steps == 64 && kCy545Motion.homing_slack_steps == 256 &&
+              kCy545Motion.homing_travel_steps == 40960 && kCy545Motion.home_switch_zone_steps == 2560);
+static_assert(kRig.homing_speed_mm_per_s < kRig.max_speed_mm_per_s && kRig.homing_slack_mm > largest_backlash_mm() &&
+              kRig.home_switch_zone_mm > kRig.home_overtravel_mm);
+inline constexpr hal::cy545::Cy545Config kCy545{kRig.mmc4s, kCy545Motion};
+
+// What the haptic backends accept from this device: its reach plus the margin per side around
+// `centre_mm`, the two angles, the force and torque limits.
+inline constexpr hal::HapticRange device_range(const std::array<double, 3>& centre_mm) {
+  return {{kRig.haptic_workspace_mm[0] / 2.0 + kRig.device_reach_margin_mm,
+           kRig.haptic_workspace_mm[1] / 2.0 + kRig.device_reach_margin_mm,
+           kRig.haptic_workspace_mm[2] / 2.0 + kRig.device_reach_margin_mm},
+          kRig.angle_limit_rad,
+          kRig.force_limit_n,
+          kRig.torque_limit_nmm,
+          {centre_mm[0], centre_mm[1], centre_mm[2]}};
+}
+// The programs' frame: the device's origin at a corner of its reach, device space [0, 500] x [0, 250]
+// x [0, 250] (world = device / 10).
+inline constexpr hal::HapticRange kDeviceRange =
+    device_range({kRig.haptic_workspace_mm[0] / 2.0, kRig.haptic_workspace_mm[1] / 2.0, kRig.haptic_workspace_mm[2] / 2.0});
+// The same reach centred on the origin (the backends' own frame, as their tests use it).
+inline constexpr hal::HapticRange kCentredDeviceRange = device_range({0.0, 0.0, 0.0});
+
+}  // namespace stencil::board::sherline_suzuki
