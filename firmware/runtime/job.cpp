@@ -1,8 +1,6 @@
 // A job's assembly from a board's parts, the resume rebuild and the machine's start.
 #include "firmware/runtime/job.hpp"
 
-#include <utility>
-
 namespace stencil::runtime {
 
 Job::Job(const JobParts& parts, Timing timing)
