@@ -50,11 +50,8 @@ void fill_result(RigResult& result, const runtime::Job& assembled, const runtime
   result.cycles = statistics.cycles;
   result.overruns = statistics.overruns;
   result.missed_periods = statistics.missed_periods;
-  result.wakeup_p99_us = statistics.wakeup_latency.quantile_us(0.99);
-  result.wakeup_p999_us = statistics.wakeup_latency.quantile_us(0.999);
-  result.wakeup_max_us = static_cast<double>(statistics.wakeup_latency.max_ns()) / 1000.0;
-  result.compute_p99_us = statistics.compute.quantile_us(0.99);
-  result.compute_max_us = static_cast<double>(statistics.compute.max_ns()) / 1000.0;
+  result.wakeup_latency_us = report::quantiles_of(statistics.wakeup_latency);
+  result.compute_us = report::quantiles_of(statistics.compute);
   result.max_force_n = std::max(controller.max_force_n(), result.earlier.max_force_n);  // the whole job
   result.max_offset_mm = std::max(controller.max_offset_mm(), result.earlier.max_offset_mm);
   result.machine_updates = assembled.machine().statistics().updates;

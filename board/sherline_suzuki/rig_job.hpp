@@ -18,6 +18,7 @@
 #include "firmware/core/control/safe_state.hpp"
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
+#include "firmware/services/report/job_report.hpp"
 #include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/runtime/periodic_runner.hpp"
 #include "firmware/core/tables/part_tables.hpp"
@@ -81,8 +82,8 @@ struct RigResult {
   bool started = false;
   std::string error;
   std::uint64_t cycles = 0, overruns = 0, missed_periods = 0;
-  double wakeup_p99_us = 0.0, wakeup_p999_us = 0.0, wakeup_max_us = 0.0;
-  double compute_p99_us = 0.0, compute_max_us = 0.0;
+  report::Quantiles wakeup_latency_us{};
+  report::Quantiles compute_us{};
   double max_force_n = 0.0, max_offset_mm = 0.0;
   std::uint64_t machine_updates = 0;
   bool machine_stop_confirmed = false;  // the link confirmed spindle and drivers off at the end

@@ -20,6 +20,7 @@
 #include "firmware/core/control/display_feed.hpp"
 #include "firmware/core/control/safe_state.hpp"
 #include "firmware/services/journal/job_history.hpp"
+#include "firmware/services/report/job_report.hpp"
 #include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
 #include "firmware/runtime/periodic_runner.hpp"
@@ -68,9 +69,7 @@ struct SimJob {
   control::DisplayFeed* display = nullptr;
 };
 
-struct Quantiles {
-  double p50, p99, p999, max;
-};
+using report::Quantiles;
 
 struct SimResult {
   bool started = false;          // false: the machine never came up (see error)

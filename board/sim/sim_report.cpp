@@ -4,45 +4,72 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 
 #include <nlohmann/json.hpp>
+
+#include "firmware/services/report/job_report.hpp"
 
 namespace stencil::board::sim {
 namespace {
 
-nlohmann::json quantiles_json(const Quantiles& q) {
-  return {{"p50", q.p50}, {"p99", q.p99}, {"p999", q.p999}, {"max", q.max}};
+// The figures every job reports, as the simulation measured them.
+report::JobFigures figures_of(const SimResult& r) {
+  report::JobFigures f;
+  f.cycles = r.cycles;
+  f.overruns = r.overruns;
+  f.missed_periods = r.missed_periods;
+  f.wakeup_latency_us = r.wakeup_latency_us;
+  f.compute_us = r.compute_us;
+  f.max_force_n = r.max_force_n;
+  f.max_offset_mm = r.max_offset_mm;
+  f.machine_updates = r.machine_updates;
+  f.machine_max_lag_mm = r.machine_max_lag_mm;
+  f.machine_stop_confirmed = r.machine_stop_confirmed;
+  f.machine_error = r.machine_error;
+  f.model_removed_volume_mm3 = r.model_removed_volume_mm3;
+  f.safe_state = r.safe_state;
+  f.earlier = r.earlier;
+  f.touched_rebuilt = r.touched_rebuilt;
+  return f;
 }
 
-// The whole job, over every run its journal recorded and this one: a fresh job is one run.
-nlohmann::json job_json(const SimResult& r) {
-  nlohmann::json safe_states = nlohmann::json::array();
-  for (const journal::RecordedFault& fault : r.earlier.faults) {
-    safe_states.push_back({{"run", fault.segment}, {"cycle", fault.cycle}, {"reason", control::safe_reason_name(fault.reason)}});
-  }
-  if (r.safe_state != control::SafeReason::None) {
-    safe_states.push_back({{"run", r.earlier.segments}, {"cycle", r.cycles}, {"reason", control::safe_reason_name(r.safe_state)}});
-  }
-  // How each run ended: the journal's End record, or none (killed, crashed); this run as it did.
-  nlohmann::json endings = nlohmann::json::array();
-  const auto ending_name = [](bool recorded, control::SafeReason reason) -> std::string {
-    return !recorded ? "unrecorded (killed or crashed)" : reason == control::SafeReason::None ? "finished" : control::safe_reason_name(reason);
+// What only the simulation measures: the ground truth of what was cut, the injected fault, the
+// simulated mill as the stop left it, the journal and the process's memory.
+nlohmann::json simulation_sections(const SimResult& r) {
+  return {
+      {"job", {{"total_simulated_s", r.earlier.recorded_s + r.simulated_s}}},
+      {"fault", r.fault_kind == FaultKind::None
+                    ? nlohmann::json(nullptr)
+                    : nlohmann::json{{"kind", fault_kind_name(r.fault_kind)},
+                                     {"injected_s", r.fault_injected_s},
+                                     {"safe_state_s", r.safe_state_s},
+                                     {"force_zero_s", r.force_zero_s},
+                                     {"machine_stopped_s", r.machine_stopped_s}}},
+      {"stock_model", {{"max_difference_mm", r.model_max_difference_mm}}},
+      {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)
+                                         : nlohmann::json{{"path", r.journal_path},
+                                                          {"cycle_records", r.journal_records},
+                                                          {"machine_records", r.journal_machine_records},
+                                                          {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
+                                                                                            : nlohmann::json(r.journal_error)}}},
+      {"memory_kb", {{"after_setup", r.rss_after_setup_kb}, {"at_end", r.rss_at_end_kb}, {"most", r.max_rss_kb}}},
+      {"simulated_s", r.simulated_s},
+      {"wall_s", r.wall_s},
+      {"gouge", {{"max_depth_mm", r.gouge_measured ? nlohmann::json(r.gouge_max_depth_mm) : nlohmann::json(nullptr)},
+                 {"volume_mm3", r.gouge_volume_mm3}}},
+      {"removed", {{"volume_mm3", r.removed_volume_mm3}}},
+      {"unmachined",
+       {{"volume_mm3", r.unmachined_volume_mm3},
+        {"fraction", r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0},
+        {"reachable_volume_mm3", r.reachable_volume_mm3}}},
+      {"coverage_fraction", r.coverage_fraction},
+      {"complete", r.complete},
+      {"machine", {{"take_ups", r.machine_take_ups},
+                   {"spindle_on_after_stop", r.mill_spindle_on_after_stop},
+                   {"drivers_on_after_stop", r.mill_drivers_on_after_stop},
+                   {"watchdog_relay_dropped_power", r.mill_relay_dropped_power},
+                   {"on_after_watchdog_relay", r.mill_on_after_relay}}},
   };
-  for (std::size_t run = 0; run < r.earlier.endings.size(); ++run) {
-    const journal::RunEnding& e = r.earlier.endings[run];
-    endings.push_back({{"run", run}, {"ending", ending_name(e.recorded, e.reason)}, {"run_cycles", e.cycles}});
-  }
-  endings.push_back({{"run", r.earlier.segments}, {"ending", ending_name(true, r.safe_state)}, {"run_cycles", r.cycles}});
-  return {{"runs", r.earlier.segments + 1},
-          {"run_endings", endings},
-          {"total_cycles", r.earlier.cycles + r.cycles},
-          {"total_simulated_s", r.earlier.recorded_s + r.simulated_s},
-          {"earlier_machine_commands", r.earlier.machine_commands},
-          {"earlier_machined_legs", r.earlier.machined_legs},
-          {"touched_recorded", r.earlier.touched_recorded},
-          {"touched_rebuilt", r.touched_rebuilt},
-          {"safe_states", safe_states}};
 }
 
 }  // namespace
@@ -68,59 +95,7 @@ bool write_stock_csv(const std::string& path, const SimResult& r, std::string& e
 }
 
 bool write_report_json(const std::string& path, const SimResult& r, std::string& error) {
-  nlohmann::json report = {
-      {"job", job_json(r)},
-      {"cycles", r.cycles},
-      {"overruns", r.overruns},
-      {"missed_periods", r.missed_periods},
-      {"fault", r.fault_kind == FaultKind::None
-                    ? nlohmann::json(nullptr)
-                    : nlohmann::json{{"kind", fault_kind_name(r.fault_kind)},
-                                     {"injected_s", r.fault_injected_s},
-                                     {"safe_state_s", r.safe_state_s},
-                                     {"force_zero_s", r.force_zero_s},
-                                     {"machine_stopped_s", r.machine_stopped_s}}},
-      {"stock_model",
-       {{"removed_volume_mm3", r.model_removed_volume_mm3}, {"max_difference_mm", r.model_max_difference_mm}}},
-      {"journal", r.journal_path.empty() ? nlohmann::json(nullptr)
-                                         : nlohmann::json{{"path", r.journal_path},
-                                                          {"cycle_records", r.journal_records},
-                                                          {"machine_records", r.journal_machine_records},
-                                                          {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
-                                                                                            : nlohmann::json(r.journal_error)}}},
-      {"memory_kb", {{"after_setup", r.rss_after_setup_kb}, {"at_end", r.rss_at_end_kb}, {"most", r.max_rss_kb}}},
-      {"simulated_s", r.simulated_s},
-      {"wall_s", r.wall_s},
-      {"wakeup_latency_us", quantiles_json(r.wakeup_latency_us)},
-      {"compute_us", quantiles_json(r.compute_us)},
-      {"gouge", {{"max_depth_mm", r.gouge_measured ? nlohmann::json(r.gouge_max_depth_mm) : nlohmann::json(nullptr)},
-                 {"volume_mm3", r.gouge_volume_mm3}}},
-      {"removed", {{"volume_mm3", r.removed_volume_mm3}}},
-      {"unmachined",
-       {{"volume_mm3", r.unmachined_volume_mm3},
-        {"fraction", r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0},
-        {"reachable_volume_mm3", r.reachable_volume_mm3}}},
-      {"coverage_fraction", r.coverage_fraction},
-      {"complete", r.complete},
-      {"max_force_n", r.max_force_n},
-      {"max_offset_mm", r.max_offset_mm},
-      {"machine", {{"updates", r.machine_updates}, {"take_ups", r.machine_take_ups}, {"max_lag_mm", r.machine_max_lag_mm},
-                   {"stop_confirmed", r.machine_stop_confirmed},
-                   {"spindle_on_after_stop", r.mill_spindle_on_after_stop},
-                   {"drivers_on_after_stop", r.mill_drivers_on_after_stop},
-                   {"watchdog_relay_dropped_power", r.mill_relay_dropped_power},
-                   {"on_after_watchdog_relay", r.mill_on_after_relay},
-                   {"error", r.machine_error.empty() ? nlohmann::json(nullptr) : nlohmann::json(r.machine_error)}}},
-      {"safe_state", r.safe_state == control::SafeReason::None ? nlohmann::json(nullptr)
-                                                                : nlohmann::json(control::safe_reason_name(r.safe_state))},
-  };
-  std::ofstream out(path);
-  out << report.dump(2) << '\n';
-  if (!out) {
-    error = path + ": cannot be written";
-    return false;
-  }
-  return true;
+  return report::write_job_report(path, figures_of(r), simulation_sections(r), error);
 }
 
 std::string summary(const SimResult& r) {

@@ -11,11 +11,6 @@
 namespace stencil::board::sim {
 namespace {
 
-Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
-  return {histogram.quantile_us(0.5), histogram.quantile_us(0.99), histogram.quantile_us(0.999),
-          static_cast<double>(histogram.max_ns()) / 1000.0};
-}
-
 // The most this process's resident memory has been (getrusage), kB.
 std::int64_t max_resident_kb() {
   rusage usage{};
@@ -32,8 +27,8 @@ void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::
   result.overruns = controller.statistics().overruns;
   result.missed_periods = controller.statistics().missed_periods;
   // In virtual time every cycle starts on its deadline: no wake-up latency to speak of.
-  result.wakeup_latency_us = realtime ? quantiles_of(controller.statistics().wakeup_latency) : Quantiles{0.0, 0.0, 0.0, 0.0};
-  result.compute_us = quantiles_of(outcome.compute);
+  result.wakeup_latency_us = realtime ? report::quantiles_of(controller.statistics().wakeup_latency) : Quantiles{0.0, 0.0, 0.0, 0.0};
+  result.compute_us = report::quantiles_of(outcome.compute);
   result.simulated_s = outcome.run_s;
   result.coverage_fraction = reachable_coverage(*job.parts().part, controller.touched());
   // Over the whole job: a resumed one's journal says what the runs before this one reached.

@@ -8,15 +8,14 @@
 
 #include <atomic>
 #include <cstdio>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "board/sherline_suzuki/rig_devices.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
+#include "board/sherline_suzuki/rig_report.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/rig_options.hpp"
 #include "firmware/programs/table_file.hpp"
@@ -135,39 +134,12 @@ void print_summary(const RigResult& result) {
               "max %.0f us; max force %.2f N; %llu machine updates, max lag %.3f mm; the model has %.1f mm3 removed\n"
               "stencil-rig: ended in the safe state: %s; faults: %s (%llu safe-state entries, %llu resets taken, %llu refused)\n",
               result.run_s, static_cast<unsigned long long>(result.cycles), static_cast<unsigned long long>(result.overruns),
-              static_cast<unsigned long long>(result.missed_periods), result.wakeup_p99_us, result.wakeup_p999_us,
-              result.wakeup_max_us, result.max_force_n, static_cast<unsigned long long>(result.machine_updates),
+              static_cast<unsigned long long>(result.missed_periods), result.wakeup_latency_us.p99,
+              result.wakeup_latency_us.p999, result.wakeup_latency_us.max, result.max_force_n, static_cast<unsigned long long>(result.machine_updates),
               result.machine_max_lag_mm, result.model_removed_mm3, control::safe_reason_name(result.safe_state),
               result.first_fault == control::SafeReason::None ? "none" : control::safe_reason_name(result.first_fault),
               static_cast<unsigned long long>(result.safe_state_entries),
               static_cast<unsigned long long>(result.resets_accepted), static_cast<unsigned long long>(result.resets_refused));
-}
-
-bool write_report(const std::string& path, const RigResult& result) {
-  const nlohmann::json report = {
-      {"cycles", result.cycles},
-      {"overruns", result.overruns},
-      {"missed_periods", result.missed_periods},
-      {"wakeup_latency_us", {{"p99", result.wakeup_p99_us}, {"p999", result.wakeup_p999_us}, {"max", result.wakeup_max_us}}},
-      {"compute_us", {{"p99", result.compute_p99_us}, {"max", result.compute_max_us}}},
-      {"max_force_n", result.max_force_n},
-      {"max_offset_mm", result.max_offset_mm},
-      {"machine", {{"updates", result.machine_updates}, {"max_lag_mm", result.machine_max_lag_mm},
-                   {"stop_confirmed", result.machine_stop_confirmed}}},
-      {"stock_model", {{"removed_volume_mm3", result.model_removed_mm3}}},
-      {"safe_state", control::safe_reason_name(result.safe_state)},
-      {"first_fault", result.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)
-                                                                        : nlohmann::json(control::safe_reason_name(result.first_fault))},
-      {"resets", {{"accepted", result.resets_accepted}, {"refused", result.resets_refused}}},
-      {"run_s", result.run_s},
-      {"job", {{"runs", result.earlier.segments + 1},
-               {"total_cycles", result.earlier.cycles + result.cycles},
-               {"earlier_safe_states", result.earlier.faults.size()},
-               {"earlier_machine_commands", result.earlier.machine_commands},
-               {"touched_recorded", result.earlier.touched_recorded},
-               {"touched_rebuilt", result.touched_rebuilt}}}};
-  std::ofstream out(path);
-  return static_cast<bool>(out << report.dump(2) << "\n");
 }
 
 // After the run: what it did, said at the terminal and in the report. The program's exit status.
@@ -184,8 +156,9 @@ int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::
   if (!journal_closed) {
     std::fprintf(stderr, "stencil-rig: %s\n", journal_writer.error().c_str());
   }
-  if (!o.report_path.empty() && !write_report(o.report_path, result)) {
-    return fail(kExitBadInput, o.report_path + ": cannot be written");
+  std::string error;
+  if (!o.report_path.empty() && !board::sherline_suzuki::write_rig_report(o.report_path, result, link.last_error(), error)) {
+    return fail(kExitBadInput, error);
   }
   const bool asked = result.safe_state == control::SafeReason::Stopped && result.first_fault == control::SafeReason::None &&
                      result.error.empty() && journal_closed && result.machine_stop_confirmed;
