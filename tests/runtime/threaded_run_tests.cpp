@@ -20,12 +20,7 @@ using namespace stencil;
 namespace {
 
 runtime::PeriodicRunner unprivileged_runner() {
-  return [](hal::MonotonicNs period_ns, const std::atomic<bool>& stop,
-            const std::function<bool(hal::MonotonicNs, hal::MonotonicNs)>& cycle, std::string& refused) {
-    const app::RealtimeSetup setup = app::run_periodic({80, -1, false}, period_ns, stop, cycle, [](const std::string&) {});
-    refused = setup.refused;
-    return setup.refused.empty();
-  };
+  return app::realtime_runner({80, -1, false}, [](const std::string&) {});
 }
 
 // From cycle `at` on (counting from 1), the device reports its own fault; on the cycle's thread.
