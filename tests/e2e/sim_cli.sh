@@ -576,6 +576,12 @@ case_refuses_a_file_that_is_not_a_table() {
   run_sim --fast --tables missing.stbl
   expect_status 2
   expect_stderr "missing.stbl: cannot be read" "the missing file"
+  # A folder given as the table: an error naming it (the program once aborted on an uncaught
+  # exception from reading it).
+  mkdir -p a_folder
+  run_sim --fast --tables a_folder
+  expect_status 2
+  expect_stderr "a_folder: cannot be read" "the folder"
 }
 
 case_refuses_an_unknown_pattern() {
