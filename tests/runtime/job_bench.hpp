@@ -92,4 +92,22 @@ class DiaryHook final : public runtime::JobHooks {
   std::uint64_t cycles_ = 0;
 };
 
+// From cycle `at` on (counting from 1), the device reports its own fault: a hook on the cycle's
+// thread (in virtual time, in the cycle's place).
+class DeviceFaultAt final : public runtime::JobHooks {
+ public:
+  DeviceFaultAt(FakeHapticDevice& device, std::uint64_t at) : device_(device), at_(at) {}
+  bool before_cycle(const runtime::CycleTime&) override {
+    if (++cycle_ == at_) {
+      device_.give(hal::ReadStatus::Fault, hal::HapticFault::DeviceHeartbeatLost);
+    }
+    return true;
+  }
+
+ private:
+  FakeHapticDevice& device_;
+  std::uint64_t at_;
+  std::uint64_t cycle_ = 0;
+};
+
 }  // namespace stencil::test

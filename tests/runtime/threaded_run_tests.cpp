@@ -23,23 +23,6 @@ runtime::PeriodicRunner unprivileged_runner() {
   return app::realtime_runner({80, -1, false}, [](const std::string&) {});
 }
 
-// From cycle `at` on (counting from 1), the device reports its own fault; on the cycle's thread.
-class DeviceFaultAt final : public runtime::JobHooks {
- public:
-  DeviceFaultAt(test::FakeHapticDevice& device, std::uint64_t at) : device_(device), at_(at) {}
-  bool before_cycle(const runtime::CycleTime&) override {
-    if (++cycle_ == at_) {
-      device_.give(hal::ReadStatus::Fault, hal::HapticFault::DeviceHeartbeatLost);
-    }
-    return true;
-  }
-
- private:
-  test::FakeHapticDevice& device_;
-  std::uint64_t at_;
-  std::uint64_t cycle_ = 0;
-};
-
 // The bench on the wall clock: the machine thread paces on CLOCK_MONOTONIC, as the runner does.
 struct WallClockBench {
   test::JobBench bench;
@@ -79,7 +62,7 @@ TEST(ThreadedRun, AFaultsSafeStateKeepsTheCycleRunningUntilTheRunsStopWhenOnlyAS
   WallClockBench wall;
   runtime::Job job(wall.parts(), runtime::Timing::RealTime);
   CHECK(job.start_machine({}) == runtime::StartFailure::None);
-  DeviceFaultAt fault(wall.bench.device, 100);
+  test::DeviceFaultAt fault(wall.bench.device, 100);
   runtime::JobHooks* const hooks[] = {&fault};
   runtime::ThreadedRun options;
   options.safe_state_ends = runtime::SafeStateEnds::AfterStop;
@@ -95,7 +78,7 @@ TEST(ThreadedRun, AnySafeStateEndsTheRunWhenSoAsked) {
   WallClockBench wall;
   runtime::Job job(wall.parts(), runtime::Timing::RealTime);
   CHECK(job.start_machine({}) == runtime::StartFailure::None);
-  DeviceFaultAt fault(wall.bench.device, 100);
+  test::DeviceFaultAt fault(wall.bench.device, 100);
   runtime::JobHooks* const hooks[] = {&fault};
   const runtime::RunOutcome outcome = runtime::run_on_threads(job, unprivileged_runner(), hooks, {});
   STRCMP_EQUAL("device_fault", control::safe_reason_name(job.controller().safe_reason()));

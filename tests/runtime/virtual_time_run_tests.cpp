@@ -15,23 +15,6 @@ using namespace stencil;
 
 namespace {
 
-// From cycle `at` on (counting from 1), the device reports its own fault.
-class DeviceFaultAt final : public runtime::JobHooks {
- public:
-  DeviceFaultAt(test::FakeHapticDevice& device, std::uint64_t at) : device_(device), at_(at) {}
-  bool before_cycle(const runtime::CycleTime&) override {
-    if (++cycle_ == at_) {
-      device_.give(hal::ReadStatus::Fault, hal::HapticFault::DeviceHeartbeatLost);
-    }
-    return true;
-  }
-
- private:
-  test::FakeHapticDevice& device_;
-  std::uint64_t at_;
-  std::uint64_t cycle_ = 0;
-};
-
 // The diary of machine updates with `cycles[i]` cycles after the i-th, and one more update.
 std::string updates_with_cycles_between(std::initializer_list<int> cycles) {
   std::string diary;
@@ -106,7 +89,7 @@ TEST(VirtualTimeRun, ASafeStateEndsTheRunAtTheUpdateAfterTheMillStoppedAndTheFor
   test::JobBench bench;
   runtime::Job job(bench.parts(), runtime::Timing::Virtual);
   CHECK(job.start_machine({}) == runtime::StartFailure::None);
-  DeviceFaultAt fault(bench.device, 101);
+  test::DeviceFaultAt fault(bench.device, 101);
   test::DiaryHook diary;
   runtime::JobHooks* const hooks[] = {&fault, &diary};
   runtime::VirtualTimeRun options;
