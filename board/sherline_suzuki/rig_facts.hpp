@@ -60,6 +60,10 @@ struct RigFacts {
   // 1000 steps/s are its stepping, but each update also spends about 15 ms of its 33 on the serial
   // line, so 1 mm/s per axis and in |dx| + |dy| + |dz|.
   double virtual_tool_speed_mm_per_s;
+  // The virtual tool keeps this far clear of the part, so the mill always has a legal staircase along
+  // its path (motion::follow_standoff_needed_mm says how much that takes; asserted below). The
+  // operator feels the wall this far out, and this much stock is left on the part.
+  double machine_standoff_mm;
   double stock_model_cell_mm;               // the controller's model of the machined stock
   int overrun_limit;                        // more overruns in a row than this: a safe state
   int stale_periods;                        // more periods than this without a fresh sample: a safe state
@@ -100,6 +104,7 @@ inline constexpr RigFacts kRig{
     .angle_limit_rad = 3.2,
     .haptic_rate_hz = 1000.0,
     .virtual_tool_speed_mm_per_s = 1.0,
+    .machine_standoff_mm = 0.02,
     .stock_model_cell_mm = 0.05,
     .overrun_limit = 3,
     .stale_periods = 5,
@@ -153,6 +158,12 @@ inline constexpr motion::PlannerLimits kPlannerLimits{
     1.0 / kRig.machine_update_hz,
     {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
      static_cast<std::int32_t>(backlash_steps(2))}};
+
+// The standoff covers every staircase the planner falls back on (13.5 um on this rig: 5 steps per axis).
+static_assert(kRig.machine_standoff_mm >= motion::follow_standoff_needed_mm(
+                                              kRig.steps_per_mm, kRig.virtual_tool_speed_mm_per_s / kRig.haptic_rate_hz),
+              "the standoff is under what the planner's fallback staircase needs");
+static_assert(motion::follow_fallback_fits(kPlannerLimits), "one update's budget must cover the fallback staircase");
 
 // The CY545 driver's configuration on this rig: its wiring, and its rates and homing in motor steps.
 inline constexpr hal::cy545::Cy545Motion kCy545Motion{

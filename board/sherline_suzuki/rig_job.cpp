@@ -3,6 +3,8 @@
 // hook of the run.
 #include "board/sherline_suzuki/rig_job.hpp"
 
+#include "firmware/runtime/stall_message.hpp"
+
 #include <algorithm>
 
 #include "board/sherline_suzuki/operator_terminal.hpp"
@@ -44,6 +46,9 @@ void fill_result(RigResult& result, const runtime::Job& assembled, const runtime
   const control::Controller& controller = assembled.controller();
   const control::LoopStatistics& statistics = controller.statistics();
   result.machine_stop_confirmed = assembled.machine().stop_confirmed();
+  if (assembled.machine().stalled()) {
+    result.machine_stall = runtime::stall_message(assembled.machine().stall());
+  }
   if (!outcome.ran) {
     result.error = outcome.error;
   }
@@ -78,7 +83,7 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
                                             kRig.haptic_workspace_mm[2]);
   control::ControllerConfig config = runtime::controller_config(
       {rig_frames(job.offset), device_workspace_mm, kRig.device_reach_margin_mm, kRig.force_limit_n,
-       kRig.torque_limit_nmm, 1.0 / kRig.haptic_rate_hz, kVirtualToolSpeedMmPerS, true});
+       kRig.torque_limit_nmm, 1.0 / kRig.haptic_rate_hz, kVirtualToolSpeedMmPerS, kRig.machine_standoff_mm, true});
   config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.overrun_limit = job.overrun_limit;
   config.stale_periods = job.stale_periods;

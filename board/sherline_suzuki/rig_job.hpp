@@ -87,6 +87,7 @@ struct RigResult {
   double max_force_n = 0.0, max_offset_mm = 0.0;
   std::uint64_t machine_updates = 0;
   bool machine_stop_confirmed = false;  // the link confirmed spindle and drivers off at the end
+  std::string machine_stall;            // the mill found no way for 3 s: where, and what was tried ("" otherwise)
   double machine_max_lag_mm = 0.0;
   double model_removed_mm3 = 0.0;
   double run_s = 0.0;

@@ -1,6 +1,8 @@
 // What a simulated job reports of itself.
 #include "board/sim/sim_result.hpp"
 
+#include "firmware/runtime/stall_message.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -42,7 +44,7 @@ void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::
     result.machine_error = mill.link().last_error();
   }
   if (machine.stalled()) {
-    result.machine_error = "the mill found no legal way along the virtual tool's path for 3 s (stalled)";
+    result.machine_error = runtime::stall_message(machine.stall());
   }
   result.safe_state_s = outcome.safe_state_s;
   result.force_zero_s = outcome.force_zero_s;

@@ -64,6 +64,9 @@ void add_record_options(CLI::App& app, SimOptions& o) {
                  "their own (on the virtual clock in lockstep with the cycle, so the job is the same job; in real time "
                  "on the wall clock), so that if this one dies, even by SIGKILL, the device's own host watchdog zeroes "
                  "the force; the device writes to LOG how long that took");
+  app.add_option("--script-csv", o.script_csv_path,
+                 "write the operator's script (the pattern's or --operator's, after a --resume's way back) to this CSV "
+                 "in the --operator format before the job runs: a random job's moves, to cut a piece out as a job of its own");
   app.add_option("--trace", o.trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
   app.add_option("--haptic-transport", o.transport,
                  "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "

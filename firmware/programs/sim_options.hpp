@@ -36,6 +36,7 @@ struct SimOptions {
   std::string stock_csv_path;
   std::string device_log_path;
   std::string trace_path;
+  std::string script_csv_path;
   std::string transport = "direct";
   DisplayOptions display;
 

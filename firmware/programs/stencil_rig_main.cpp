@@ -157,7 +157,11 @@ int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::
     std::fprintf(stderr, "stencil-rig: %s\n", journal_writer.error().c_str());
   }
   std::string error;
-  if (!o.report_path.empty() && !board::sherline_suzuki::write_rig_report(o.report_path, result, link.last_error(), error)) {
+  const std::string machine_error = result.machine_stall.empty() ? std::string(link.last_error()) : result.machine_stall;
+  if (!result.machine_stall.empty()) {
+    std::fprintf(stderr, "stencil-rig: %s\n", result.machine_stall.c_str());
+  }
+  if (!o.report_path.empty() && !board::sherline_suzuki::write_rig_report(o.report_path, result, machine_error, error)) {
     return fail(kExitBadInput, error);
   }
   const bool asked = result.safe_state == control::SafeReason::Stopped && result.first_fault == control::SafeReason::None &&

@@ -420,7 +420,8 @@ int main(int argc, char** argv) {
   job.fault = o.fault;
   job.until_complete = o.until_complete;
   SideFiles files;
-  if (!open_trace(o, job, files, error)) {
+  if ((!o.script_csv_path.empty() && !sim::write_operator_csv(o.script_csv_path, job.script, error)) ||
+      !open_trace(o, job, files, error)) {
     return bad_input(error);
   }
   if (isatty(STDERR_FILENO) != 0) {

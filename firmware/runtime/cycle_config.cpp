@@ -14,6 +14,7 @@ control::ControllerConfig controller_config(const CycleFacts& facts) {
   config.device_high_mm = facts.device_workspace_mm + Eigen::Vector3d::Constant(facts.device_reach_margin_mm);
   config.home_tip_mm = facts.frames.home_world_mm;
   config.count_overruns = facts.count_overruns;
+  config.standoff_mm = facts.standoff_mm;
   // Per period: the virtual tool is held to what the mill follows.
   config.max_axis_move_mm = facts.virtual_tool_speed_mm_per_s * facts.period_s;
   config.max_total_move_mm = facts.virtual_tool_speed_mm_per_s * facts.period_s;

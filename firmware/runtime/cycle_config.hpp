@@ -17,6 +17,7 @@ struct CycleFacts {
   double torque_limit_nmm;
   double period_s;                        // the cycle's
   double virtual_tool_speed_mm_per_s;     // what the mill follows, per axis and |dx| + |dy| + |dz|
+  double standoff_mm;                     // the virtual tool keeps this clear of the part (ControllerConfig)
   bool count_overruns;                    // in real time; in virtual time lateness means nothing
 };
 

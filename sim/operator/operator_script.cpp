@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -268,6 +269,25 @@ bool read_operator_csv(const std::string& path, OperatorScript& script, std::str
     return false;
   }
   return parse_operator_csv(in, path, script, error);
+}
+
+bool write_operator_csv(const std::string& path, const OperatorScript& script, std::string& error) {
+  std::FILE* file = std::fopen(path.c_str(), "w");
+  if (file == nullptr) {
+    error = path + ": cannot be written";
+    return false;
+  }
+  bool written = std::fprintf(file, "t_s,x_mm,y_mm,z_mm,a_rad,b_rad\n") > 0;
+  for (std::size_t i = 0; i < script.t_s.size() && written; ++i) {
+    const Eigen::Vector2d angles = i < script.angles_rad.size() ? script.angles_rad[i] : Eigen::Vector2d::Zero();
+    written = std::fprintf(file, "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g\n", script.t_s[i], script.device_mm[i].x(),
+                           script.device_mm[i].y(), script.device_mm[i].z(), angles.x(), angles.y()) > 0;
+  }
+  written = std::fclose(file) == 0 && written;
+  if (!written) {
+    error = path + ": could not be written in full";
+  }
+  return written;
 }
 
 bool parse_operator_csv(std::istream& in, const std::string& path, OperatorScript& script, std::string& error) {

@@ -64,6 +64,9 @@ enum class Pattern : std::uint8_t { Raster, Plunge, Thinwall, Random };
 // A script from CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] (device space, times increasing). On bad
 // input returns false with `error` naming the file (`name`), the line and what was expected.
 [[nodiscard]] bool read_operator_csv(const std::string& path, OperatorScript& script, std::string& error);
+// The script as read_operator_csv reads it back (a header line, then t_s,x_mm,y_mm,z_mm,a_rad,b_rad
+// rows with every digit a double needs). False with `error` naming the file when it cannot be written.
+[[nodiscard]] bool write_operator_csv(const std::string& path, const OperatorScript& script, std::string& error);
 [[nodiscard]] bool parse_operator_csv(std::istream& in, const std::string& name, OperatorScript& script,
                                       std::string& error);
 

@@ -429,9 +429,10 @@ TEST(Controller, AResetWhileTheDeviceLinkIsStillDownIsRefused) {
 }
 
 // The mill's backlog slows the virtual tool: at full speed below half the path, not at all from
-// 90 % (the mill catches up instead of the path filling, which would be a machine fault), and back
-// to full speed once the backlog drains.
-TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtNinetyPercentHoldsIt) {
+// 87 % (the mill catches up instead of the path filling, which would leave a gap in it), nor while
+// the machine side reports 100 % for a mill that found no way, and back to full speed once the
+// backlog drains.
+TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtEightySevenPercentHoldsIt) {
   ControllerConfig c = config();
   c.max_axis_move_mm = 1e-3;
   c.max_total_move_mm = 1e-3;
@@ -447,8 +448,9 @@ TEST(Controller, TheMillsBacklogSlowsTheVirtualToolAndAtNinetyPercentHoldsIt) {
   bench.move_device_to(kHomeDevice - Eigen::Vector3d(100.0, 0.0, 0.0), 500.0);
   DOUBLES_EQUAL(1e-3, moved_in_a_cycle(10), 1e-12);
   DOUBLES_EQUAL(1e-3, moved_in_a_cycle(50), 1e-12);
-  DOUBLES_EQUAL(0.5e-3, moved_in_a_cycle(70), 1e-12);
-  DOUBLES_EQUAL(0.0, moved_in_a_cycle(90), 0.0);
+  DOUBLES_EQUAL(12.0 / 37.0 * 1e-3, moved_in_a_cycle(75), 1e-12);
+  DOUBLES_EQUAL(1.0 / 37.0 * 1e-3, moved_in_a_cycle(86), 1e-12);
+  DOUBLES_EQUAL(0.0, moved_in_a_cycle(87), 0.0);
   DOUBLES_EQUAL(0.0, moved_in_a_cycle(100), 0.0);
   CHECK(bench.controller->safe_reason() == SafeReason::None);  // slowed, not a fault
   DOUBLES_EQUAL(1e-3, moved_in_a_cycle(20), 1e-12);

@@ -11,6 +11,7 @@
 #include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/core/motion/machine_planner.hpp"
 #include "firmware/core/motion/speed_limit.hpp"
+#include "firmware/core/stencil/standoff.hpp"
 #include "firmware/core/stencil/sweep.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
@@ -120,9 +121,12 @@ Run drive(MachinePlanner& planner, const tables::PartTables& part, const std::ve
 // The virtual tool's path at the mill's speed from `from` through `waypoints`, remediated by the
 // engine (so it hugs the part where a waypoint is inside it).
 std::vector<Eigen::Vector3d> virtual_path(const tables::PartTables& part, const Eigen::Vector3d& from,
-                                          const std::vector<Eigen::Vector3d>& waypoints, double speed_fraction) {
+                                          const std::vector<Eigen::Vector3d>& waypoints, double speed_fraction,
+                                          double standoff_mm = 0.0) {
   const MachineSpeed speed{1.4 * speed_fraction, 1000.0 * speed_fraction, 640.0};
-  engine::VirtualTool tool(part, from);
+  engine::StandoffPart view{};
+  CHECK(engine::build_standoff_part(part, standoff_mm, view));
+  engine::VirtualTool tool(view, from);
   tool.limit_speed(speed.max_axis_speed_mm_per_s * 0.001, speed.step_rate_steps_per_s / speed.steps_per_mm * 0.001);
   std::vector<Eigen::Vector3d> path;
   for (const Eigen::Vector3d& waypoint : waypoints) {
@@ -331,3 +335,83 @@ TEST(MachinePlanner, TheQueueHoldsAtMostTwoUpdates) {
   CHECK_EQUAL(2, planner.queued());
   CHECK(planner.plan(1).status == PlanStatus::Moved);
 }
+
+// The standoff the rig keeps (0.02 mm) is more than the planner's argument needs: 5 steps per axis
+// of 1/640 mm, sqrt(3) times over (13.5 um), with the virtual tool's 1 um a cycle; and one update's
+// budget covers the fallback's move. A virtual tool faster than a step a cycle voids the argument.
+TEST(MachinePlanner, TheStandoffTheArgumentNeedsIsUnderTheRigsAndTheFallbackFitsAnUpdate) {
+  DOUBLES_EQUAL(std::sqrt(3.0) * 5.0 / 640.0, follow_standoff_needed_mm(640.0, 0.001), 1e-12);
+  CHECK(follow_standoff_needed_mm(640.0, 0.001) < 0.02);
+  CHECK(follow_standoff_needed_mm(640.0, 0.002) > 1.0);
+  CHECK(follow_fallback_fits(sherline_limits()));
+  PlannerLimits slow = sherline_limits();
+  slow.speed.max_axis_speed_mm_per_s = 0.2;  // 4 steps an update: too few
+  CHECK_FALSE(follow_fallback_fits(slow));
+}
+
+namespace {
+
+// The virtual tool as the cycle moves it: the hand's point (the desired tip) walks through
+// `waypoints` at 0.8 mm/s, deep into the part where they are, and the tool follows as far as it is
+// legal, at most 1 um an axis a cycle (the rig's speed limit), keeping `standoff_mm` off the part.
+std::vector<Eigen::Vector3d> pressed_path(const tables::PartTables& part, const Eigen::Vector3d& from,
+                                          const std::vector<Eigen::Vector3d>& waypoints, double standoff_mm) {
+  engine::StandoffPart view{};
+  CHECK(engine::build_standoff_part(part, standoff_mm, view));
+  engine::VirtualTool tool(view, from);
+  tool.limit_speed(1e-3, 1e-3);
+  std::vector<Eigen::Vector3d> path;
+  Eigen::Vector3d hand = from;
+  for (const Eigen::Vector3d& waypoint : waypoints) {
+    while ((waypoint - hand).norm() > 1e-9) {
+      const Eigen::Vector3d step = waypoint - hand;
+      hand = step.norm() <= 0.8e-3 ? waypoint : Eigen::Vector3d(hand + 0.8e-3 * step.normalized());
+      CHECK(tool.step(hand, engine::ContactParameters{}).status != engine::RemediationStatus::Fault);
+      path.push_back(tool.tip_mm());
+    }
+  }
+  for (int cycle = 0; cycle < 3000; ++cycle) {  // the hand rests where it ended: the tool settles
+    static_cast<void>(tool.step(hand, engine::ContactParameters{}));
+    path.push_back(tool.tip_mm());
+  }
+  return path;
+}
+
+// A hand pressed hard into the prism: down onto the top and along it over the edge (where a job
+// stalled: the tool rides the edge a micrometre off it), round a vertex low on the walls, and down
+// into the concave corner of a wall and the floor from several directions; the mill follows at
+// 30 Hz (every staircase checked in drive()). Returns the updates that found no way.
+int blocked_following_a_pressed_tool(double standoff_mm) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  const MachineFrames frames = sherline_frames();
+  const Eigen::Vector3d start(17.7, 9.8, 7.0);
+  MachineSteps start_steps{};
+  CHECK(world_to_steps(frames, start, start_steps));
+  planner.homed(start_steps, {1, 1, 1});
+  const std::vector<Eigen::Vector3d> waypoints = {
+      {18.76, 12.16, 0.18}, {18.69, 12.39, 0.1}, {21.33, 9.46, 0.34}, {22.0, 8.69, 0.63},  {23.36, 7.05, 2.69},
+      {33.0, 9.5, 8.0},     {33.0, 9.5, 2.0},    {31.5, 12.5, 2.0},   {31.0, 16.5, 1.0},   {31.0, 15.5, -1.0},
+      {32.0, 14.0, -2.0},   {30.5, 17.0, -1.5},  {31.5, 13.0, -0.5},  {31.0, 16.0, -3.0},  {29.0, 18.0, -1.0}};
+  const std::vector<Eigen::Vector3d> path =
+      pressed_path(part, steps_to_world(frames, start_steps), waypoints, standoff_mm);
+  const Run run = drive(planner, part, path, 300);
+  int blocked = 0;
+  for (const PlanResult& r : run.updates) {
+    blocked += r.status == PlanStatus::Blocked ? 1 : 0;
+  }
+  const Eigen::Vector3d reached = steps_to_world(frames, planner.axis_steps());
+  std::printf("\n  pressed over the prism's edge, round a vertex and into its corner with the floor, standoff "
+              "%.3f mm: %zu updates, %d blocked, the mill ends %.4f mm from the virtual tool\n",
+              standoff_mm, run.updates.size(), blocked, (reached - path.back()).norm());
+  return blocked;
+}
+
+}  // namespace
+
+// With the rig's standoff the mill always has a way: not one update blocked, whatever the hand does.
+TEST(MachinePlanner, WithTheStandoffTheMillFollowsAToolPressedIntoTheFloorsCornerFromEveryDirection) {
+  CHECK_EQUAL(0, blocked_following_a_pressed_tool(0.02));
+}
+

@@ -47,7 +47,7 @@ struct JobBench {
     const motion::MachineFrames frames{10.0, Eigen::Vector3d::Zero(), home_world_mm, {-1, -1, -1}, 640.0};
     // A device 500 x 250 x 250 mm reaching 25 mm past it, 5 N and 200 N mm, a 1 ms cycle, 1 mm/s.
     parts.controller =
-        runtime::controller_config({frames, Eigen::Vector3d(500.0, 250.0, 250.0), 25.0, 5.0, 200.0, 1e-3, 1.0, count_overruns});
+        runtime::controller_config({frames, Eigen::Vector3d(500.0, 250.0, 250.0), 25.0, 5.0, 200.0, 1e-3, 1.0, 0.0, count_overruns});
     parts.planner = {{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}};
     parts.update_ns = kUpdateNs;
     parts.shut_down_bound_ns = 3 * kUpdateNs;

@@ -1,6 +1,8 @@
 // The cycle: commands -> read -> engine -> write -> publish, and the latched safe state.
 #include "firmware/core/control/controller.hpp"
 
+#include "firmware/core/motion/machine_planner.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -8,6 +10,13 @@ namespace stencil::control {
 namespace {
 
 constexpr double kNsPerS = 1e9;
+
+// The virtual tool stops once the mill's path is this full: the path then has room for a whole
+// handoff ring more (4096 x 13 % > 512), all a machine update can take in before it reports again,
+// so the path never fills while the cycle runs (a full path would leave a gap in it).
+constexpr double kBacklogHoldPercent = 87.0;
+static_assert((100.0 - kBacklogHoldPercent) / 100.0 * motion::MachinePlanner::kPathCapacity >
+              MachineHandoffRing::capacity());
 
 Eigen::Vector3d position_of(const hal::HapticSample& sample) {
   return {sample.position_mm[0], sample.position_mm[1], sample.position_mm[2]};
@@ -23,8 +32,15 @@ void copy3(const Eigen::Vector3d& from, double (&to)[3]) {
 
 Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device, const CycleRings& rings,
                        const ControllerConfig& config)
-    : part_(part), device_(device), rings_(rings), config_(config), tool_(part, config.home_tip_mm) {
-  ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
+    : part_(part),
+      device_(device),
+      rings_(rings),
+      config_(config),
+      standoff_built_(engine::build_standoff_part(part, config.standoff_mm, standoff_)),
+      tool_(standoff_, config.home_tip_mm) {
+  // Touched: within the tolerance of the virtual tool, which keeps the standoff off the part.
+  ready_ = standoff_built_ &&
+           engine::build_contact_tool(part.tool.spec, touch_distance_mm(), contact_tool_);
   tool_.limit_speed(config.max_axis_move_mm, config.max_total_move_mm);
   last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
   board_force_limit_n_ = config.haptic.max_force_n;
@@ -155,7 +171,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
 
 void Controller::recall_touched(const Eigen::Vector3d& tip_mm) {
   static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip_mm, Eigen::Vector3d::UnitZ()},
-                                         config_.contact_tolerance_mm, touched_));
+                                         touch_distance_mm(), touched_));
 }
 
 bool Controller::read_device(hal::MonotonicNs now_ns) {
@@ -283,14 +299,16 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
   if (safe_reason_ != SafeReason::None || !usable || waiting_for_hand_) {
     return outcome;
   }
-  // The mill's backlog: past half its path the virtual tool slows, to a stop at 90 %, so the mill
-  // catches up; the hand feels the tool lag (a firmer spring) instead of the job ending in a fault.
-  const double backlog_scale = std::clamp((90.0 - backlog_percent_) / 40.0, 0.0, 1.0);
+  // The mill's backlog: past half its path the virtual tool slows, to a stop at kBacklogHoldPercent,
+  // so the mill catches up; the hand feels the tool lag (a firmer spring) instead of the job ending
+  // in a fault. The machine side also reports 100 % while it finds no way for the mill.
+  const double backlog_scale =
+      std::clamp((kBacklogHoldPercent - backlog_percent_) / (kBacklogHoldPercent - 50.0), 0.0, 1.0);
   if (std::isfinite(config_.max_axis_move_mm) && std::isfinite(config_.max_total_move_mm)) {
     tool_.limit_speed(backlog_scale * config_.max_axis_move_mm, backlog_scale * config_.max_total_move_mm);
   }
   const Eigen::Vector3d& desired = outcome.desired_tip_mm;
-  outcome.contact = engine::query_contacts(part_, {desired, Eigen::Vector3d::UnitZ()}, config_.contact);
+  outcome.contact = tool_.contact_at(desired, config_.contact);
   const engine::RemediationResult moved = tool_.step(desired, outcome.contact, config_.contact);
   outcome.remediation = moved.status;
   outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic);
@@ -298,8 +316,7 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
       outcome.output.fault) {
     enter_safe_state(SafeReason::EngineFault);
   } else {
-    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), config_.contact_tolerance_mm,
-                                           touched_));
+    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), touch_distance_mm(), touched_));
     max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
   }
   return outcome;

@@ -31,6 +31,10 @@ struct ControllerConfig {
   Eigen::Vector3d device_high_mm;
   Eigen::Vector3d home_tip_mm;            // world: where the virtual tool starts (the machine's home)
   double contact_tolerance_mm = 0.005;    // a point this near the virtual tool is touched
+  // The virtual tool keeps this far clear of the part (engine/standoff.hpp): the mill can then always
+  // follow it (motion/machine_planner.hpp has the argument); as much stock is left on the part.
+  // 0: none (the engine's own tests); a board sets its own (above motion::follow_standoff_needed_mm).
+  double standoff_mm = 0.0;
   // The most the virtual tool may move in one period, per axis and all axes together (|dx|+|dy|+|dz|),
   // so the mill can follow (motion::MachineSpeed times the period); unlimited by default.
   double max_axis_move_mm = std::numeric_limits<double>::infinity();
@@ -78,7 +82,8 @@ class Controller {
   Controller(const Controller&) = delete;
   Controller& operator=(const Controller&) = delete;
 
-  // False when the grown contact tool could not be built (bad tool in the tables): do not run.
+  // False when the grown contact tool or the standoff's grown tool could not be built (a bad tool in
+  // the tables, a standoff out of range): do not run.
   [[nodiscard]] bool ready() const { return ready_; }
   // A held start still waiting for the hand (ControllerConfig::start_held).
   [[nodiscard]] bool waiting_for_hand() const { return waiting_for_hand_; }
@@ -111,6 +116,8 @@ class Controller {
   [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
 
  private:
+  // How near the real tool's surface a point is touched: the tolerance beyond the standoff.
+  [[nodiscard]] double touch_distance_mm() const { return config_.contact_tolerance_mm + standoff_.standoff_mm; }
   void enter_safe_state(SafeReason reason);
   void write_zero_force();
   void handle_commands(hal::MonotonicNs now_ns);
@@ -148,6 +155,8 @@ class Controller {
   hal::HapticDevice& device_;
   CycleRings rings_;
   ControllerConfig config_;
+  engine::StandoffPart standoff_{};  // the part as the engine sees it (before tool_, which keeps a reference)
+  bool standoff_built_ = false;
   engine::VirtualTool tool_;
   geometry::ToolBsp contact_tool_{};
   engine::TriangleSet touched_;

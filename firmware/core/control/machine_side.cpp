@@ -69,9 +69,12 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   }
   // The backlog, so the cycle can slow the virtual tool before the path fills (which is a fault).
   // Only while the ring has room to spare: a fault's event must always find a slot.
+  // A mill that found no way at its last update reports 100 %: the cycle holds the virtual tool
+  // (a firmer spring for the hand) until it has one again.
   if (to_cycle_.size() < MachineEventRing::capacity() / 2) {
     const auto percent = static_cast<std::uint8_t>(
-        std::min<std::size_t>(100, 100 * planner_.path_size() / motion::MachinePlanner::kPathCapacity));
+        blocked_in_a_row_ > 0 ? 100
+                              : std::min<std::size_t>(100, 100 * planner_.path_size() / motion::MachinePlanner::kPathCapacity));
     static_cast<void>(to_cycle_.push({.kind = MachineEventKind::Backlog, .backlog_percent = percent}));
   }
   if (safe_state) {
@@ -142,6 +145,7 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
       // (with the backlog holding the virtual tool, nothing would ever move again).
       if (++blocked_in_a_row_ > kMaxBlockedUpdates) {
         stalled_ = true;
+        stall_ = {planner_.newest_mm(), commanded_tip_mm_, planner_.last_blocked_search()};
         stop(update_deadline_ns, true);
       }
       break;

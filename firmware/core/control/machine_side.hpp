@@ -79,8 +79,18 @@ class MachineSide {
   // the mill (slow storage costs time, not the cut).
   static constexpr int kMaxUnrecordedUpdates = 120;
   // More updates than this in a row with no legal staircase (3 s at 30 Hz) is a fault: stalled().
+  // With the standoff it cannot happen while the virtual tool moves legally (the planner's
+  // argument); it stays as the last guard. Until then the virtual tool is held (the backlog at 100 %).
   static constexpr int kMaxBlockedUpdates = 90;
   [[nodiscard]] bool stalled() const { return stalled_; }
+  // Where a stall happened: the virtual tool's newest tip, the mill's (commanded) tip, and what the
+  // last search tried (valid once stalled()).
+  struct Stall {
+    Eigen::Vector3d virtual_tip_mm;
+    Eigen::Vector3d mill_tip_mm;
+    motion::PlanSearch search;
+  };
+  [[nodiscard]] const Stall& stall() const { return stall_; }
   // After a stop: whether the link confirmed the spindle and drivers off (false: they may still be
   // on, whatever the cycle's safe state says; the operator must cut the mill's power).
   [[nodiscard]] bool stop_confirmed() const { return stop_confirmed_; }
@@ -111,6 +121,7 @@ class MachineSide {
   int unrecorded_updates_ = 0;
   int blocked_in_a_row_ = 0;
   bool stalled_ = false;
+  Stall stall_{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), {}};
   bool stop_confirmed_ = false;
   Eigen::Vector3d commanded_tip_mm_;
 };

@@ -120,7 +120,8 @@ bool MachinePlanner::clip_to_budget(const Eigen::Vector3d& goal, Eigen::Vector3d
 // legal itself, and reached by a legal staircase in some order. The nearest of the cell's corners
 // first: the virtual tool runs a micrometre off the part, closer than the grid's own rounding, so
 // the nearest corner may be inside where another is not.
-bool MachinePlanner::grid_target(const Eigen::Vector3d& wanted, MachineSteps& target, AxisOrder& order) const {
+bool MachinePlanner::grid_target(const Eigen::Vector3d& wanted, MachineSteps& target, AxisOrder& order,
+                                 PlanSearch& search) const {
   if (!wanted.allFinite() || (wanted.cwiseAbs().array() > static_cast<double>(kMaxMachineSteps)).any()) {
     return false;
   }
@@ -137,10 +138,11 @@ bool MachinePlanner::grid_target(const Eigen::Vector3d& wanted, MachineSteps& ta
       holds = true;
     }
   }
-  return (holds && corner_target(held, target, order)) || corner_target(wanted, target, order);
+  return (holds && corner_target(held, target, order, search)) || corner_target(wanted, target, order, search);
 }
 
-bool MachinePlanner::corner_target(const Eigen::Vector3d& exact, MachineSteps& target, AxisOrder& order) const {
+bool MachinePlanner::corner_target(const Eigen::Vector3d& exact, MachineSteps& target, AxisOrder& order,
+                                   PlanSearch& search) const {
   const Eigen::Vector3d low = exact.array().floor();
   // Corners that would reverse an axis cost a backlash take-up (tens of steps): after the others.
   std::array<std::pair<double, int>, 8> corners{};
@@ -168,10 +170,12 @@ bool MachinePlanner::corner_target(const Eigen::Vector3d& exact, MachineSteps& t
     if (!within || total > total_budget_ || corner == axis_) {
       continue;
     }
+    ++search.corners;
     if (engine::check_tip_legal(part_, steps_to_world(frames_, corner)) != engine::Legality::Legal) {
       continue;
     }
-    if (legal_order(corner, order) >= 0) {
+    ++search.legal_corners;
+    if (legal_order(corner, order, search) >= 0) {
       target = corner;
       return true;
     }
@@ -181,7 +185,7 @@ bool MachinePlanner::corner_target(const Eigen::Vector3d& exact, MachineSteps& t
 
 // The first order whose staircase from the current position to `to` (itself legal) is legal, leg
 // by leg; -1 when none is (or the tables fault: the caller cannot tell, and holds either way).
-int MachinePlanner::legal_order(const MachineSteps& to, AxisOrder& order) const {
+int MachinePlanner::legal_order(const MachineSteps& to, AxisOrder& order, PlanSearch& search) const {
   std::array<bool, 6> seen_paths{};
   for (std::size_t o = 0; o < kOrders.size(); ++o) {
     // Orders that differ only where an axis does not move are the same path.
@@ -205,6 +209,7 @@ int MachinePlanner::legal_order(const MachineSteps& to, AxisOrder& order) const 
       continue;
     }
     seen_paths[o] = true;
+    ++search.staircases;
     MachineSteps corner = axis_;
     bool legal = true;
     for (const std::uint8_t axis : kOrders[o]) {
@@ -213,6 +218,7 @@ int MachinePlanner::legal_order(const MachineSteps& to, AxisOrder& order) const 
       }
       MachineSteps next = corner;
       next.axis[axis] = to.axis[axis];
+      ++search.legs;
       const engine::SweepResult leg = engine::check_sweep(part_, steps_to_world(frames_, corner),
                                                           steps_to_world(frames_, next), sweep_step_mm_,
                                                           kMaxLegSubSteps);
@@ -263,17 +269,11 @@ PlanResult MachinePlanner::plan(int completed) {
   }
 
   // Follow the virtual tool's path, never a shortcut across it: the farthest point along the path
-  // whose net move from here fits this update, then, if no staircase to it is legal, the path's
-  // earlier points, then part of the way to the first one.
-  MachineSteps goal{};
-  while (path_size_ > 0) {  // points the mill already stands on are passed
-    if (!world_to_steps(frames_, path_at(0), goal)) {
-      return result(PlanStatus::Fault);
-    }
-    if (!(goal == axis_)) {
-      break;
-    }
-    drop_path_before(1);
+  // whose move from here fits this update, then earlier points, and last of all the path's first
+  // point, to which some staircase is always legal (kFollowStandoff's argument above
+  // follow_standoff_needed_mm). Only path points: the mill stays near one, which the argument needs.
+  if (!pass_points_at_hand()) {
+    return result(PlanStatus::Fault);
   }
   if (path_size_ == 0) {
     return result(PlanStatus::AtGoal);
@@ -283,30 +283,30 @@ PlanResult MachinePlanner::plan(int completed) {
   while (within < path_size_ && clip_to_budget(exact_steps(path_at(within)), clipped)) {
     ++within;
   }
-  const bool beyond = within < path_size_;  // a point out of this update's reach follows
   MachineSteps target{};
   AxisOrder order{};
   std::size_t passed = 0;  // path points the mill is done with once at target
   bool found = false;
-  for (int candidate = 0; candidate < kMaxCandidates && !found; ++candidate) {
+  PlanSearch search{};
+  search.next_point_mm = path_at(0);
+  for (int candidate = 0; candidate <= kMaxCandidates && !found; ++candidate) {
     Eigen::Vector3d exact;
-    if (candidate == 0 && beyond) {
-      // Towards the first point out of reach, as far as the budget goes.
-      static_cast<void>(clip_to_budget(exact_steps(path_at(within)), exact));
-      passed = within;
-    } else {
-      const auto back = static_cast<std::size_t>(candidate - (beyond ? 1 : 0));
-      if (back < within) {
-        exact = exact_steps(path_at(within - 1 - back));
-        passed = within - back;
-      } else {
-        // Part of the way towards the path's first point: a half, a quarter, ...
-        static_cast<void>(clip_to_budget(exact_steps(path_at(0)), exact));
-        exact = current() + (exact - current()) / std::ldexp(1.0, static_cast<int>(back - within + 1));
-        passed = 0;
+    if (within > 0) {
+      const std::size_t index = candidate_index(candidate, within);
+      if (candidate > 0 && index == candidate_index(candidate - 1, within)) {
+        break;  // the first point was tried: nothing is left to try
       }
+      exact = exact_steps(path_at(index));
+      passed = index + 1;
+    } else {
+      // Not even the first point is in reach (a gap in the path, which the cycle never leaves):
+      // part of the way towards it, as far as the budget goes, then a half of that, a quarter, ...
+      static_cast<void>(clip_to_budget(exact_steps(path_at(0)), exact));
+      exact = current() + (exact - current()) / std::ldexp(1.0, candidate);
+      passed = 0;
     }
-    found = grid_target(exact, target, order);
+    ++search.candidates;
+    found = grid_target(exact, target, order, search);
   }
   if (found) {
     bool reverses = false;
@@ -338,7 +338,37 @@ PlanResult MachinePlanner::plan(int completed) {
     r.motor_steps = moved;
     return r;
   }
+  blocked_search_ = search;
   return result(PlanStatus::Blocked);
+}
+
+bool MachinePlanner::pass_points_at_hand() {
+  while (path_size_ > 0) {
+    MachineSteps goal{};
+    if (!world_to_steps(frames_, path_at(0), goal)) {
+      return false;
+    }
+    const Eigen::Vector3d exact = exact_steps(path_at(0));
+    bool at_hand = true;
+    for (std::size_t i = 0; i < 3; ++i) {
+      at_hand = at_hand && std::abs(exact[static_cast<Eigen::Index>(i)] - static_cast<double>(axis_.axis[i])) < 1.0;
+    }
+    if (!at_hand) {
+      return true;
+    }
+    drop_path_before(1);
+  }
+  return true;
+}
+
+// Candidates walk back from the farthest reachable point, 1, 2, 4, 8, ... points at a time, and end
+// on the path's first point (index 0): kMaxCandidates + 1 of them reach back over the whole path.
+std::size_t MachinePlanner::candidate_index(int candidate, std::size_t within) {
+  if (candidate >= kMaxCandidates) {
+    return 0;
+  }
+  const std::size_t back = candidate == 0 ? 0 : (std::size_t{1} << static_cast<unsigned>(candidate - 1));
+  return back >= within ? 0 : within - 1 - back;
 }
 
 }  // namespace stencil::motion

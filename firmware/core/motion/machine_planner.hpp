@@ -27,6 +27,42 @@ struct PlannerLimits {
   std::array<std::int32_t, 3> backlash_steps; // slack per axis, taken up on every reversal
 };
 
+// Why the mill can always follow a virtual tool that keeps a standoff s from the part
+// (engine/standoff.hpp), with h one step and v the most the virtual tool moves along an axis in a
+// cycle (v <= h):
+//  - The path's points are the virtual tool's tips, each legal for the tool grown by s, so the real
+//    tool is legal anywhere within s of one of them (the grown tool contains the real one moved by
+//    up to s). A point is stored once it rounds to another step than the last stored one, so on
+//    each axis it is less than h + v from it.
+//  - The mill only ever goes to a grid point of a path point's cell (a corner, each axis within h
+//    of it) or, on an axis it holds against a small reversal, stays less than
+//    kReversalDeadbandSteps + 1 steps from it; that point is then the mill's anchor a: on each axis
+//    the mill g is less than (kReversalDeadbandSteps + 1) h from a. Points whose cell has g as a
+//    corner are passed without moving (g is within h of them).
+//  - The path's next point p is always a candidate (the last tried). Take the corner c of p's cell
+//    inside the workspace (the workspace's faces count too): each axis of c is within h of p, so
+//    less than 2h + v from a. Every point of a staircase from g to c, in any order, lies axis by
+//    axis between g and c, so less than max(kReversalDeadbandSteps + 1, 2 + v/h) h from a on each
+//    axis: within sqrt(3) times that of a, which is within s: legal, as is c. The move is under
+//    kReversalDeadbandSteps + 4 steps per axis: inside one update's budget (follow_fallback_fits).
+// So some staircase is always legal, the planner finds it (it tries every corner and order), and
+// the mill never stalls while the virtual tool moves legally. The standoff that takes:
+constexpr double follow_standoff_needed_mm(double steps_per_mm, double max_axis_move_per_cycle_mm) {
+  const double step_mm = 1.0 / steps_per_mm;
+  if (!(max_axis_move_per_cycle_mm <= step_mm)) {
+    return 1e300;  // the argument needs v <= h: no standoff is enough for it
+  }
+  const double held = kReversalDeadbandSteps + 1.0;
+  const double next = 2.0 + max_axis_move_per_cycle_mm / step_mm;
+  return 1.7320508075688772 * (held > next ? held : next) * step_mm;
+}
+// One update's budget covers the fallback's move (with the step of room clip_to_budget keeps).
+constexpr bool follow_fallback_fits(const PlannerLimits& limits) {
+  const double per_axis = kReversalDeadbandSteps + 4.0;
+  return limits.speed.max_axis_speed_mm_per_s * limits.update_period_s * limits.speed.steps_per_mm >= per_axis + 1.0 &&
+         limits.speed.step_rate_steps_per_s * limits.update_period_s >= 3.0 * per_axis + 1.0;
+}
+
 // The order in which the mill moves its axes inside one update (the CY545 steps one axis at a
 // time): the machine link must execute the legs in this order, since only this staircase was
 // checked.
@@ -40,6 +76,16 @@ enum class PlanStatus : std::uint8_t {
   Blocked,      // no legal staircase to any point of the path within this update: holding
   NotHomed,     // no target before homed()
   Fault,        // bad numbers or damaged tables: stop the machine
+};
+
+// What the search of the last update that found no way tried (the stall's report says it).
+struct PlanSearch {
+  int candidates = 0;       // path points (or part-way points) tried
+  int corners = 0;          // their grid corners within the budget
+  int legal_corners = 0;    // of which the mill may stand on
+  int staircases = 0;       // orders tried towards those
+  int legs = 0;             // one-axis legs checked along them
+  Eigen::Vector3d next_point_mm = Eigen::Vector3d::Zero();  // the path's first point not yet reached
 };
 
 struct PlanResult {
@@ -61,8 +107,9 @@ enum class PathStatus : std::uint8_t {
 };
 
 // Owned by the machine side: its own read-only view of the tables, its own engine scratch (each
-// legality query), never the touched set. Allocation-free after construction; plan() does at most
-// kMaxCandidates x 6 orders x 3 legs sweeps, each of a bounded number of sub-steps.
+// legality query), never the touched set. Allocation-free after construction; plan() tries at most
+// kMaxCandidates + 1 candidates x 8 corners x 6 orders x 3 legs sweeps, each of a bounded number of
+// sub-steps.
 class MachinePlanner {
  public:
   static constexpr std::size_t kPathCapacity = 4096;  // points at least a step apart: seconds of motion
@@ -87,6 +134,10 @@ class MachinePlanner {
   [[nodiscard]] const MachineSteps& motor_steps() const { return motor_; }
   [[nodiscard]] std::size_t path_size() const { return path_size_; }
   [[nodiscard]] int queued() const { return queued_; }
+  // The newest virtual tool tip handed to follow().
+  [[nodiscard]] const Eigen::Vector3d& newest_mm() const { return newest_mm_; }
+  // What the last plan() that returned Blocked tried.
+  [[nodiscard]] const PlanSearch& last_blocked_search() const { return blocked_search_; }
 
  private:
   [[nodiscard]] const Eigen::Vector3d& path_at(std::size_t i) const;
@@ -94,9 +145,15 @@ class MachinePlanner {
   [[nodiscard]] Eigen::Vector3d exact_steps(const Eigen::Vector3d& world_mm) const;
   [[nodiscard]] Eigen::Vector3d current() const;
   [[nodiscard]] bool clip_to_budget(const Eigen::Vector3d& goal, Eigen::Vector3d& clipped) const;
-  [[nodiscard]] bool grid_target(const Eigen::Vector3d& wanted, MachineSteps& target, AxisOrder& order) const;
-  [[nodiscard]] bool corner_target(const Eigen::Vector3d& exact, MachineSteps& target, AxisOrder& order) const;
-  [[nodiscard]] int legal_order(const MachineSteps& to, AxisOrder& order) const;
+  [[nodiscard]] bool grid_target(const Eigen::Vector3d& wanted, MachineSteps& target, AxisOrder& order,
+                                 PlanSearch& search) const;
+  [[nodiscard]] bool corner_target(const Eigen::Vector3d& exact, MachineSteps& target, AxisOrder& order,
+                                   PlanSearch& search) const;
+  [[nodiscard]] int legal_order(const MachineSteps& to, AxisOrder& order, PlanSearch& search) const;
+  // Drops the path's points the mill stands at a corner of (it is within a step of them).
+  [[nodiscard]] bool pass_points_at_hand();
+  // The path's point `back` candidates before the farthest reachable one (`within` of them reachable).
+  [[nodiscard]] static std::size_t candidate_index(int candidate, std::size_t within);
   [[nodiscard]] PlanResult result(PlanStatus status) const;
 
   const tables::PartTables& part_;
@@ -116,6 +173,7 @@ class MachinePlanner {
   std::size_t path_head_ = 0;
   std::size_t path_size_ = 0;
   Eigen::Vector3d newest_mm_ = Eigen::Vector3d::Zero();
+  PlanSearch blocked_search_{};
 };
 
 }  // namespace stencil::motion

@@ -33,6 +33,13 @@ double slip_length_mm(const tables::PartTables& part, const Eigen::Vector3d& tip
 
 }  // namespace
 
+VirtualTool::VirtualTool(const StandoffPart& view, const Eigen::Vector3d& home_tip_mm)
+    : part_(view.part),
+      standoff_(view.standoff_mm),
+      tip_(view.to_engine(home_tip_mm)),
+      box_high_(view.part.header.workspace_mm[0], view.part.header.workspace_mm[1], view.part.header.workspace_mm[2]),
+      sweep_step_(engine::sweep_step_mm(view.part)) {}
+
 VirtualTool::VirtualTool(const tables::PartTables& part, const Eigen::Vector3d& home_tip_mm)
     : part_(part),
       tip_(home_tip_mm),
@@ -78,14 +85,15 @@ VirtualTool::Slip VirtualTool::slip_out(Eigen::Vector3d& candidate, const Contac
 
 RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const ContactResult& contact_at_desired,
                                     const ContactParameters& parameters) {
-  RemediationResult result{RemediationStatus::Stuck, tip_, 0, 0, false};
+  RemediationResult result{RemediationStatus::Stuck, tip_mm(), 0, 0, false};
   if (!desired_tip_mm.allFinite()) {
     result.status = RemediationStatus::Fault;
     return result;
   }
   // The floor and the workspace walls are planes of the stencil: project onto them analytically.
-  Eigen::Vector3d candidate = clamp_to_box(desired_tip_mm);
-  const bool clamped = candidate != desired_tip_mm;
+  const Eigen::Vector3d desired = to_engine(desired_tip_mm);
+  Eigen::Vector3d candidate = clamp_to_box(desired);
+  const bool clamped = candidate != desired;
   // The first candidate is the desired pose itself unless a wall of the box moved it.
   switch (slip_out(candidate, clamped ? nullptr : &contact_at_desired, parameters, result.slip_iterations)) {
     case Slip::Fault:
@@ -142,7 +150,7 @@ RemediationResult VirtualTool::step(const Eigen::Vector3d& desired_tip_mm, const
           (result.slip_iterations > 0 || clamped || slid) ? RemediationStatus::Slipped : RemediationStatus::Followed;
       break;
   }
-  result.tip_mm = tip_;
+  result.tip_mm = tip_mm();
   return result;
 }
 
