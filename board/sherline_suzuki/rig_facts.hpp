@@ -104,7 +104,7 @@ inline constexpr RigFacts kRig{
     .angle_limit_rad = 3.2,
     .haptic_rate_hz = 1000.0,
     .virtual_tool_speed_mm_per_s = 1.0,
-    .machine_standoff_mm = 0.02,
+    .machine_standoff_mm = 0.015,
     .stock_model_cell_mm = 0.05,
     .overrun_limit = 3,
     .stale_periods = 5,

@@ -20,6 +20,7 @@ MillWiring::MillWiring(const SimJob& job, bool realtime)
   // The rig's hardware watchdog relay on the heartbeat output (Mmc4sWiring::heartbeat_output).
   fake_.board().arm_watchdog_relay(kMmc4sWiring.heartbeat_output, kWatchdogRelayNs, epoch_ns_);
   machined_.set_trace(job.trace);
+  machined_.set_allowance(kStandoffMm);  // the controller's standoff: stock it means to leave
   mill_.set_motion_observer(&machined_);
   char port_error[256] = {};
   if (!port_.open(fake_.slave_path().c_str(), kBaud, port_error)) {

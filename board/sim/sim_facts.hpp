@@ -33,6 +33,8 @@ inline constexpr motion::PlannerLimits kPlannerLimits = rig::kPlannerLimits;
 // mill's stepping). The scripted hand moves a little slower than that (0.8 of it), so that the
 // virtual tool keeps up with it and a scripted job is not a tug against the speed limit.
 inline constexpr double kVirtualToolSpeedMmPerS = rig::kRig.virtual_tool_speed_mm_per_s;
+// The virtual tool keeps this clear of the part: stock the job means to leave (not unmachined).
+inline constexpr double kStandoffMm = rig::kRig.machine_standoff_mm;
 inline constexpr double kOperatorSpeedMmPerS = 0.8 * kVirtualToolSpeedMmPerS;
 
 // The controller's model of the machined stock: the rig's cells, as fine as the simulated mill's Z-map.

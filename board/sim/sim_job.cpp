@@ -55,7 +55,7 @@ control::ControllerConfig controller_config(bool realtime) {
   // Overruns count in real time only: in virtual time lateness means nothing.
   return runtime::controller_config({frames(), device_workspace_mm, rig::kRig.device_reach_margin_mm,
                                      rig::kRig.force_limit_n, rig::kRig.torque_limit_nmm, 1.0 / rig::kRig.haptic_rate_hz,
-                                     kVirtualToolSpeedMmPerS, rig::kRig.machine_standoff_mm, realtime});
+                                     kVirtualToolSpeedMmPerS, kStandoffMm, realtime});
 }
 
 std::function<double(double, double)> touch_tip_of(const tables::PartTables& part, const stencil::sim::StockBox& stock) {

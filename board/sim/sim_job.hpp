@@ -87,6 +87,7 @@ struct SimResult {
   double removed_volume_mm3 = 0.0;
   double unmachined_volume_mm3 = 0.0;
   double reachable_volume_mm3 = 0.0;
+  double allowance_volume_mm3 = 0.0;   // left on the part by the controller's standoff (not unmachined)
   double coverage_fraction = 0.0;  // reachable triangles touched
   double max_force_n = 0.0;
   double max_offset_mm = 0.0;

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "board/sim/sim_facts.hpp"
 #include "firmware/services/report/job_report.hpp"
 
 namespace stencil::board::sim {
@@ -61,7 +62,9 @@ nlohmann::json simulation_sections(const SimResult& r) {
       {"unmachined",
        {{"volume_mm3", r.unmachined_volume_mm3},
         {"fraction", r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0},
-        {"reachable_volume_mm3", r.reachable_volume_mm3}}},
+        {"reachable_volume_mm3", r.reachable_volume_mm3},
+        {"standoff_mm", kStandoffMm},
+        {"standoff_volume_mm3", r.allowance_volume_mm3}}},
       {"coverage_fraction", r.coverage_fraction},
       {"complete", r.complete},
       {"machine", {{"take_ups", r.machine_take_ups},
@@ -104,7 +107,8 @@ std::string summary(const SimResult& r) {
   std::snprintf(text, sizeof text,
                 "simulated %.1f s in %.1f s (%llu cycles, %llu machine updates)\n"
                 "gouge: %s mm deepest, %.3f mm3 under the part's top\n"
-                "stock removed %.1f mm3; unmachined %.2f mm3 = %.2f %% of what this tool can reach\n"
+                "stock removed %.1f mm3; unmachined %.2f mm3 = %.2f %% of what this tool can reach (beyond the %.3f mm "
+                "standoff, which leaves %.2f mm3)\n"
                 "coverage %.1f %% of reachable triangles; max force %.2f N; max offset %.3f mm; max machine lag %.3f mm\n"
                 "cycle compute p50 %.1f us, p99.9 %.1f us, max %.1f us (wall clock)\n"
                 "safe state: %s\n",
@@ -112,6 +116,7 @@ std::string summary(const SimResult& r) {
                 static_cast<unsigned long long>(r.machine_updates),
                 r.gouge_measured ? std::to_string(r.gouge_max_depth_mm).c_str() : "not measured (not a ball end mill)",
                 r.gouge_volume_mm3, r.removed_volume_mm3, r.unmachined_volume_mm3, 100.0 * fraction,
+                kStandoffMm, r.allowance_volume_mm3,
                 100.0 * r.coverage_fraction, r.max_force_n, r.max_offset_mm, r.machine_max_lag_mm, r.compute_us.p50,
                 r.compute_us.p999, r.compute_us.max,
                 r.safe_state == control::SafeReason::None ? "none" : control::safe_reason_name(r.safe_state));

@@ -61,6 +61,7 @@ void fill_stock(SimResult& result, const control::CommandedStock& model, const s
   result.removed_volume_mm3 = volumes.removed_mm3;
   result.unmachined_volume_mm3 = volumes.unmachined_mm3;
   result.reachable_volume_mm3 = volumes.reachable_mm3;
+  result.allowance_volume_mm3 = volumes.allowance_mm3;
   const stencil::sim::StockZmap& stock = machined.stock();
   result.columns = stock.columns();
   result.rows = stock.rows();

@@ -217,10 +217,17 @@ std::vector<double> part_top_heights(const tables::PartTables& part, const Stock
 
 std::vector<double> MachinedPart::part_heights() const { return part_top_heights(part_, stock_); }
 
-std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& part) const {
+std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& part, double allowance_mm) const {
   const int columns = stock_.columns(), rows = stock_.rows();
   const double top = stock_.box().high_mm.z();
-  const std::vector<double> tip = lowest_tips(stock_, part, tool_);
+  // The lowest tips of the tool grown by the allowance (its tip that much lower than the real one's).
+  ToolProfile grown = tool_;
+  grown.radius_mm += allowance_mm;
+  grown.corner_radius_mm += grown.kind == geometry::CutterKind::BullNose ? allowance_mm : 0.0;
+  std::vector<double> tip = lowest_tips(stock_, part, grown);
+  for (double& t : tip) {
+    t += allowance_mm;
+  }
   // The lowest the tool's surface can come over each cell from any of those tips.
   const std::vector<Offset> footprint = footprint_of(stock_, tool_);
   const auto inside = [&](int c, int r) { return r >= 0 && r < rows && c >= 0 && c < columns; };
@@ -244,11 +251,12 @@ std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& p
 
 MachinedPart::Volumes MachinedPart::volumes() const {
   const std::vector<double> part = part_heights();
-  const std::vector<double> reachable = reachable_heights(part);
+  const std::vector<double> reachable = reachable_heights(part, allowance_mm_);
+  const std::vector<double> exact = allowance_mm_ > 0.0 ? reachable_heights(part, 0.0) : reachable;
   const double cell = stock_.cell_mm();
   const double floor = stock_.box().low_mm.z();
   const double top = stock_.box().high_mm.z();
-  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0, std::vector<double>(reachable.size(), 0.0)};
+  Volumes v{stock_.removed_volume_mm3(), 0.0, 0.0, 0.0, 0.0, std::vector<double>(reachable.size(), 0.0)};
   for (int row = 0; row < stock_.rows(); ++row) {
     for (int column = 0; column < stock_.columns(); ++column) {
       const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(stock_.columns()) + static_cast<std::size_t>(column);
@@ -259,8 +267,10 @@ MachinedPart::Volumes MachinedPart::volumes() const {
       v.reachable_mm3 += std::max(0.0, top - reachable[i]);
       v.unmachined_mm3 += v.unmachined_per_cell_mm[i];
       v.gouge_mm3 += std::max(0.0, part[i] - left);
+      v.allowance_mm3 += std::max(0.0, std::max(reachable[i], floor) - std::max(exact[i], floor));
     }
   }
+  v.allowance_mm3 *= cell * cell;
   v.reachable_mm3 *= cell * cell;
   v.unmachined_mm3 *= cell * cell;
   v.gouge_mm3 *= cell * cell;

@@ -52,6 +52,11 @@ class MachinedPart final : public MillMotionObserver {
   // it follows would be. Before arm().
   void cut_recorded_leg(const Eigen::Vector3d& from_mm, const Eigen::Vector3d& to_mm);
 
+  // The stock the job means to leave on the part: the controller keeps its virtual tool this far
+  // clear of it (its standoff), so what this tool can reach is measured for the tool kept as far
+  // off, and the allowance's own volume apart (Volumes::allowance_mm3). 0 until set.
+  void set_allowance(double standoff_mm) { allowance_mm_ = standoff_mm; }
+
   // Every corner is also written to `trace` as t_s,x_mm,y_mm,z_mm (null: none).
   void set_trace(std::FILE* trace) { trace_ = trace; }
 
@@ -69,8 +74,9 @@ class MachinedPart final : public MillMotionObserver {
   struct Volumes {
     double removed_mm3;
     double gouge_mm3;         // stock cut below the part's top surface
-    double unmachined_mm3;    // stock this tool could have removed, still there
-    double reachable_mm3;     // all the stock this tool could have removed
+    double unmachined_mm3;    // stock this tool could have removed, still there (beyond the allowance)
+    double reachable_mm3;     // all the stock this tool could have removed (kept the allowance off)
+    double allowance_mm3;     // the stock the allowance leaves on the part
     std::vector<double> unmachined_per_cell_mm;  // over each cell, how thick what is left there is
   };
   [[nodiscard]] Volumes volumes() const;
@@ -83,13 +89,15 @@ class MachinedPart final : public MillMotionObserver {
   [[nodiscard]] double leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
   void corner(const Eigen::Vector3d& tip);
   // The lowest the tool's surface can come over each cell from any legal tip (the reachable surface).
-  [[nodiscard]] std::vector<double> reachable_heights(const std::vector<double>& part) const;
+  // With an allowance: the tool's tip kept allowance_mm off the part (the tool grown by it).
+  [[nodiscard]] std::vector<double> reachable_heights(const std::vector<double>& part, double allowance_mm) const;
 
   const tables::PartTables& part_;
   motion::MachineFrames frames_;
   std::function<double()> now_s_;
   StockZmap stock_;
   ToolProfile tool_;
+  double allowance_mm_ = 0.0;
   std::array<std::int64_t, kMillAxisCount> home_{};
   bool armed_ = false;
   int leg_axis_ = -1;

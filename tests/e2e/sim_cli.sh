@@ -186,6 +186,45 @@ case_random() {
   no_gouge
 }
 
+# A random job that used to end in a stall (the mill found no legal staircase for 3 s, 1,400 s in:
+# the virtual tool rode the prism's top edge a micrometre off it, the hand pressed deep below) runs
+# past that point: the standoff keeps a legal way open for the mill. About a minute.
+case_random_job_that_stalled_runs_past_its_stall() {
+  run_sim --fast --pattern random --seed 3 --moves 600 --duration 1410 --no-journal --report report.json
+  expect_status 0
+  no_gouge
+  grep -q stalled stdout.txt stderr.txt report.json && fail "the mill stalled"
+  return 0
+}
+
+# A hand pressed hard into the concave corner where the prism's walls meet the floor, from several
+# directions in turn (each point is inside the prism and 1.5-2 mm under the floor, as low as the device reaches), and over the top's edge:
+# the mill follows all the way: no stall, no other safe state, no gouge.
+case_pressed_into_the_floor_corner_from_several_directions() {
+  cat >pressed.csv <<'CSV'
+t_s,x_mm,y_mm,z_mm
+0,500,250,250
+25,345,95,250
+45,345,95,20
+60,310,125,-20
+75,345,100,10
+90,320,165,-20
+105,345,100,10
+120,300,175,-20
+135,330,140,-15
+150,345,95,10
+165,300,100,90
+180,200,120,30
+195,180,200,40
+210,340,95,80
+CSV
+  run_sim --fast --operator pressed.csv --no-journal --report report.json
+  expect_status 0
+  no_gouge
+  grep -q stalled stdout.txt stderr.txt report.json && fail "the mill stalled"
+  return 0
+}
+
 # The same inputs give the same report, apart from the wall-clock fields.
 case_same_report_twice() {
   strip_wall_clock() {

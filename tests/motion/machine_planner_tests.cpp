@@ -336,12 +336,12 @@ TEST(MachinePlanner, TheQueueHoldsAtMostTwoUpdates) {
   CHECK(planner.plan(1).status == PlanStatus::Moved);
 }
 
-// The standoff the rig keeps (0.02 mm) is more than the planner's argument needs: 5 steps per axis
+// The standoff the rig keeps (0.015 mm) is more than the planner's argument needs: 5 steps per axis
 // of 1/640 mm, sqrt(3) times over (13.5 um), with the virtual tool's 1 um a cycle; and one update's
 // budget covers the fallback's move. A virtual tool faster than a step a cycle voids the argument.
 TEST(MachinePlanner, TheStandoffTheArgumentNeedsIsUnderTheRigsAndTheFallbackFitsAnUpdate) {
   DOUBLES_EQUAL(std::sqrt(3.0) * 5.0 / 640.0, follow_standoff_needed_mm(640.0, 0.001), 1e-12);
-  CHECK(follow_standoff_needed_mm(640.0, 0.001) < 0.02);
+  CHECK(follow_standoff_needed_mm(640.0, 0.001) < 0.015);
   CHECK(follow_standoff_needed_mm(640.0, 0.002) > 1.0);
   CHECK(follow_fallback_fits(sherline_limits()));
   PlannerLimits slow = sherline_limits();
@@ -412,6 +412,6 @@ int blocked_following_a_pressed_tool(double standoff_mm) {
 
 // With the rig's standoff the mill always has a way: not one update blocked, whatever the hand does.
 TEST(MachinePlanner, WithTheStandoffTheMillFollowsAToolPressedIntoTheFloorsCornerFromEveryDirection) {
-  CHECK_EQUAL(0, blocked_following_a_pressed_tool(0.02));
+  CHECK_EQUAL(0, blocked_following_a_pressed_tool(0.015));
 }
 
