@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak soak-asan same-behaviour fresh-check clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour fresh-check clean help
 
 all: build
 
@@ -14,6 +14,7 @@ help:
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
 	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
 	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
+	@echo "make stall-seeds the random operator for STALL_HOURS (2) on seeds 1..STALL_SEEDS (20): no stall, no gouge (build/stall-seeds)"
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
 	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
@@ -70,6 +71,13 @@ SOAK_FAULTS ?= 12
 SOAK_SEED ?= 1
 soak: build
 	bash toolchain/soak.sh build/bin/stencil-sim build/soak $(SOAK_HOURS) $(SOAK_FAULTS) $(SOAK_SEED)
+
+# A measurement, not a test: the random operator for STALL_HOURS on STALL_SEEDS seeds, no stall allowed
+# (toolchain/stall-seeds.sh).
+STALL_SEEDS ?= 20
+STALL_HOURS ?= 2
+stall-seeds: build
+	bash toolchain/stall-seeds.sh build/bin/stencil-sim build/stall-seeds $(STALL_SEEDS) $(STALL_HOURS) 2
 
 soak-asan: deps
 	cmake --preset asan

@@ -3,8 +3,6 @@
 // hook of the run.
 #include "board/sherline_suzuki/rig_job.hpp"
 
-#include "firmware/runtime/stall_message.hpp"
-
 #include <algorithm>
 
 #include "board/sherline_suzuki/operator_terminal.hpp"
@@ -12,6 +10,7 @@
 #include "firmware/runtime/cycle_config.hpp"
 #include "firmware/runtime/job.hpp"
 #include "firmware/runtime/threaded_run.hpp"
+#include "firmware/runtime/stall_message.hpp"
 
 namespace stencil::board::sherline_suzuki {
 namespace {

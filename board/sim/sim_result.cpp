@@ -1,14 +1,14 @@
 // What a simulated job reports of itself.
 #include "board/sim/sim_result.hpp"
 
-#include "firmware/runtime/stall_message.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include <sys/resource.h>
 #include <unistd.h>
+
+#include "firmware/runtime/stall_message.hpp"
 
 namespace stencil::board::sim {
 namespace {

@@ -1,10 +1,10 @@
 // The cycle: commands -> read -> engine -> write -> publish, and the latched safe state.
 #include "firmware/core/control/controller.hpp"
 
-#include "firmware/core/motion/machine_planner.hpp"
-
 #include <algorithm>
 #include <cmath>
+
+#include "firmware/core/motion/machine_planner.hpp"
 
 namespace stencil::control {
 namespace {
