@@ -10,6 +10,7 @@
 #include "firmware/core/stencil/standoff.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
+#include "tests/support/loaded_part.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
@@ -56,13 +57,8 @@ void check_contains_moved_tool(const geometry::ToolSpec& spec, double standoff) 
   CHECK(checked > 10000);
 }
 
-struct Loaded {
-  tablegen::TableBytes bytes;
-  tables::PartTables part{};
-  explicit Loaded(const std::vector<tablegen::Facet>& facets)
-      : bytes(test::make_table(facets, test::default_job_options(2))) {
-    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
-  }
+struct Loaded : test::LoadedPart {
+  explicit Loaded(const std::vector<tablegen::Facet>& facets) : test::LoadedPart(facets) { CHECK(loaded); }
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "firmware/core/stencil/sweep.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
+#include "tests/support/loaded_part.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "tests/support/gouge_oracle.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
@@ -26,13 +27,8 @@ namespace {
 const Eigen::Vector3d kHome(25.0, 12.5, 20.0);  // above every sample part
 
 
-struct Loaded {
-  tablegen::TableBytes bytes;
-  tables::PartTables part{};
-  explicit Loaded(const std::vector<tablegen::Facet>& facets)
-      : bytes(test::make_table(facets, test::default_job_options(2))) {
-    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
-  }
+struct Loaded : test::LoadedPart {
+  explicit Loaded(const std::vector<tablegen::Facet>& facets) : test::LoadedPart(facets) { CHECK(loaded); }
 };
 
 // Drives the virtual tool through `path` and checks every cycle against the oracle.
