@@ -287,6 +287,19 @@ TEST(HmiRequests, ParametersBeyondTheBoardsLimitsAreRefusedWithTheReason) {
 
 TEST_GROUP(HmiLiveState){};
 
+// With a standoff the virtual tool stays that far off the part, and the cycle counts a triangle
+// touched within the tolerance beyond it: the display's mirror must mark the same way, or it never
+// sees a triangle touched (its coverage stuck at 0 while the cycle's grew).
+TEST(HmiLiveState, WithAStandoffTheMirrorMarksWhereTheCycleDoes) {
+  Prism prism;
+  control::ControllerConfig c = config();
+  c.standoff_mm = 0.015;
+  LiveState state(prism.part, c, limits_of(c));
+  // Resting on the top face (z = 6) the standoff over it, as the cycle leaves the virtual tool.
+  state.on_record(record_at(1, Eigen::Vector3d(25.0, 12.5, 6.0 + 0.015 + 0.001), 1));
+  CHECK(state.touched_count() >= 1U);
+}
+
 TEST(HmiLiveState, TheTouchedSetIsMirroredFromTheRecordsAndSentAsDeltasThenWhole) {
   Prism prism;
   LiveState state(prism.part, config(), limits_of(config()));

@@ -40,7 +40,7 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
       tool_(standoff_, config.home_tip_mm) {
   // Touched: within the tolerance of the virtual tool, which keeps the standoff off the part.
   ready_ = standoff_built_ &&
-           engine::build_contact_tool(part.tool.spec, touch_distance_mm(), contact_tool_);
+           engine::build_contact_tool(part.tool.spec, touch_distance_mm(config_), contact_tool_);
   tool_.limit_speed(config.max_axis_move_mm, config.max_total_move_mm);
   last_command_ = {{0.0, 0.0, 0.0}, {0.0, 0.0}, 0, false};
   board_force_limit_n_ = config.haptic.max_force_n;
@@ -171,7 +171,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
 
 void Controller::recall_touched(const Eigen::Vector3d& tip_mm) {
   static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip_mm, Eigen::Vector3d::UnitZ()},
-                                         touch_distance_mm(), touched_));
+                                         touch_distance_mm(config_), touched_));
 }
 
 bool Controller::read_device(hal::MonotonicNs now_ns) {
@@ -316,7 +316,7 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
       outcome.output.fault) {
     enter_safe_state(SafeReason::EngineFault);
   } else {
-    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), touch_distance_mm(), touched_));
+    static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), touch_distance_mm(config_), touched_));
     max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
   }
   return outcome;

@@ -57,6 +57,13 @@ struct ControllerConfig {
   double max_coupling_n_per_device_mm = 2.0;
 };
 
+// How near the real tool's surface a point of the part counts as touched: the tolerance beyond the
+// standoff the virtual tool keeps (it never comes closer). The cycle and whoever re-marks the touched
+// set from the virtual tool's tips (the display, a resumed job's rebuild) use this one figure.
+[[nodiscard]] inline double touch_distance_mm(const ControllerConfig& config) {
+  return config.contact_tolerance_mm + config.standoff_mm;
+}
+
 enum class CycleStatus : std::uint8_t {
   Running,    // force is being rendered
   SafeState,  // force zero, machine told to stop; see safe_reason()
@@ -116,8 +123,6 @@ class Controller {
   [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
 
  private:
-  // How near the real tool's surface a point is touched: the tolerance beyond the standoff.
-  [[nodiscard]] double touch_distance_mm() const { return config_.contact_tolerance_mm + standoff_.standoff_mm; }
   void enter_safe_state(SafeReason reason);
   void write_zero_force();
   void handle_commands(hal::MonotonicNs now_ns);

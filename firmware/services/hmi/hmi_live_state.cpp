@@ -61,7 +61,7 @@ void TimingBins::add(std::int64_t ns) {
 
 LiveState::LiveState(const tables::PartTables& part, const control::ControllerConfig& config, const HmiLimits& limits)
     : part_(part), config_(config), limits_(limits), touched_(std::make_unique<engine::TriangleSet>()) {
-  contact_tool_ready_ = engine::build_contact_tool(part.tool.spec, config.contact_tolerance_mm, contact_tool_);
+  contact_tool_ready_ = engine::build_contact_tool(part.tool.spec, control::touch_distance_mm(config), contact_tool_);
   touched_->observe(&LiveState::heard_touched, this);
   telemetry_.coupling_n_per_device_mm = config.haptic.coupling_n_per_device_mm;
   telemetry_.force_limit_n = config.haptic.max_force_n;
@@ -94,7 +94,7 @@ void LiveState::on_record(const control::JournalRecord& record) {
   if (record.touched_triangles > touched_->count() && contact_tool_ready_) {
     const Eigen::Vector3d tip(record.virtual_tip_mm[0], record.virtual_tip_mm[1], record.virtual_tip_mm[2]);
     static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip, Eigen::Vector3d::UnitZ()},
-                                           config_.contact_tolerance_mm, *touched_));
+                                           control::touch_distance_mm(config_), *touched_));
   }
   const Eigen::Vector3d f(static_cast<double>(record.force_n[0]), static_cast<double>(record.force_n[1]),
                           static_cast<double>(record.force_n[2]));
