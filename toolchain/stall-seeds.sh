@@ -35,6 +35,7 @@ for seed in $(seq 1 "$seeds"); do
   fi
   simulated=$(json_number "$r" simulated_s)
   safe=$(grep -E '"safe_state": ' "$r" | head -n 1 | sed -E 's/.*": "?([^",]*)"?,?$/\1/')
+  [ "$safe" = null ] && safe=none  # the report's null: the job ended in no safe state
   gouge=$(grep -A3 '"gouge"' "$r" | json_number /dev/stdin max_depth_mm)
   unmachined=$(grep -A3 '"unmachined"' "$r" | json_number /dev/stdin fraction)
   coverage=$(json_number "$r" coverage_fraction)
