@@ -239,6 +239,15 @@ CSV
   return 0
 }
 
+# --script-csv to a file that cannot be written: refused before the job runs, naming the file.
+case_script_csv_that_cannot_be_written_is_refused() {
+  run_sim --fast --pattern raster --duration 1 --no-journal --script-csv no-such-folder/script.csv --report report.json
+  expect_status 2
+  expect_stderr "no-such-folder/script.csv: cannot be written" "which file could not be written"
+  [ ! -e report.json ] || fail "a report was written for a job that did not run"
+  return 0
+}
+
 # The same inputs give the same report, apart from the wall-clock fields.
 case_same_report_twice() {
   strip_wall_clock() {
