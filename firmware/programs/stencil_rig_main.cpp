@@ -225,7 +225,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "stencil-rig: the other threads could not be kept off CPU %d\n", o.cpu);
   }
   app::Display display;
-  if (!display.start(o.display, part, board::sherline_suzuki::rig_controller_config(job), error)) {
+  if (!display.start(o.display, part, board::sherline_suzuki::rig_controller_config(job), "stencil-rig", error)) {
     if (!journal::undo_unrun_job_journal(request, journal_writer, journal_path)) {
       std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", o.resume_path.c_str());
     }
@@ -247,6 +247,9 @@ int main(int argc, char** argv) {
   const RigResult result = board::sherline_suzuki::run_rig(
       job, app::realtime_runner({o.priority, o.cpu, o.require_rt},
                                 [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); }));
+  display.end(result.started ? "the job ended after " + std::to_string(result.cycles) + " cycles, in the safe state (" +
+                                   control::safe_reason_name(result.safe_state) + ")"
+                             : "the job did not start: " + result.error);
   display.stop();
   if (journal_writer.is_open() && result.started) {
     static_cast<void>(journal_writer.append_end(result.cycles, result.safe_state));  // an orderly end, not a kill

@@ -443,7 +443,7 @@ int main(int argc, char** argv) {
   }
   // The display, before the job: a page opened now sees the job from its start.
   app::Display display;
-  if (!display.start(o.display, part, board::sim::controller_config(o.real_time()), error)) {
+  if (!display.start(o.display, part, board::sim::controller_config(o.real_time()), "stencil-sim", error)) {
     return bad_input(error);
   }
   job.display = display.feed();
@@ -452,6 +452,10 @@ int main(int argc, char** argv) {
   if (job.progress) {
     std::fprintf(stderr, "\n");
   }
+  display.end("the job ended after " + std::to_string(result.cycles) + " cycles" +
+              (result.safe_state == control::SafeReason::None
+                   ? std::string(", not in a safe state")
+                   : std::string(", in the safe state (") + control::safe_reason_name(result.safe_state) + ")"));
   display.stop();
   files.close();
   return finish(o, result, request, journal_writer, journal_path);

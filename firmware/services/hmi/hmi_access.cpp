@@ -1,5 +1,13 @@
 #include "firmware/services/hmi/hmi_access.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
 #include <arpa/inet.h>
 
 #include <charconv>
@@ -107,6 +115,51 @@ bool same_origin(std::string_view origin, std::string_view host) {
     }
   }
   return false;  // "null" (a file:// page, a sandboxed frame) or anything else
+}
+
+}  // namespace stencil::hmi
+
+namespace stencil::hmi {
+
+bool read_token_file(const std::string& path, std::string& token, std::string& error) {
+  const int fd = open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) {
+    error = "--token-file " + path + ": " + std::strerror(errno);
+    return false;
+  }
+  struct stat st {};
+  std::string text;
+  bool ok = fstat(fd, &st) == 0;
+  if (!ok || !S_ISREG(st.st_mode)) {
+    error = "--token-file " + path + ": not a regular file";
+  } else if (st.st_uid != geteuid()) {
+    error = "--token-file " + path + ": owned by uid " + std::to_string(st.st_uid) + ", not by this user (" +
+            std::to_string(geteuid()) + ")";
+    ok = false;
+  } else if ((st.st_mode & 077) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(st.st_mode & 07777));
+    error = "--token-file " + path + ": mode " + mode + " lets others read it; chmod 600 " + path;
+    ok = false;
+  } else {
+    char buffer[512];
+    const ssize_t got = read(fd, buffer, sizeof buffer);
+    text.assign(buffer, got > 0 ? static_cast<std::size_t>(got) : 0);
+  }
+  close(fd);
+  if (!ok) {
+    return false;
+  }
+  const std::size_t line_end = text.find('\n');
+  text = text.substr(0, line_end);
+  const std::size_t first = text.find_first_not_of(" \t\r");
+  const std::size_t last = text.find_last_not_of(" \t\r");
+  token = first == std::string::npos ? std::string() : text.substr(first, last - first + 1);
+  if (token.empty()) {
+    error = "--token-file " + path + ": empty (expected the token on its first line)";
+    return false;
+  }
+  return true;
 }
 
 }  // namespace stencil::hmi

@@ -33,3 +33,13 @@ struct HmiEndpoint {
 [[nodiscard]] bool same_origin(std::string_view origin, std::string_view host);
 
 }  // namespace stencil::hmi
+
+namespace stencil::hmi {
+
+// The token from a file (its first line, without surrounding blanks) that only its owner, this
+// user, may read or write: a token never comes from the command line or the environment, where
+// other users' `ps` and /proc would see it. For a service, systemd's LoadCredential= gives such a file.
+// False with the reason (missing, another user's, readable by others, empty).
+[[nodiscard]] bool read_token_file(const std::string& path, std::string& token, std::string& error);
+
+}  // namespace stencil::hmi

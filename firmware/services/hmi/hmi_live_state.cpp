@@ -2,9 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "firmware/core/control/safe_state.hpp"
-#include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/tables/table_format.hpp"
 
 namespace stencil::hmi {
 namespace {
@@ -15,247 +16,241 @@ nlohmann::json point(const double (&p)[3]) {
   return nlohmann::json::array({rounded(p[0], 1e-4), rounded(p[1], 1e-4), rounded(p[2], 1e-4)});
 }
 
-nlohmann::json point(const Eigen::Vector3d& p) {
-  return nlohmann::json::array({rounded(p.x(), 1e-4), rounded(p.y(), 1e-4), rounded(p.z(), 1e-4)});
+nlohmann::json bins(const display_link::TimingHistogram& timing) {
+  return {{"bin_us", display_link::kTimingBinUs},
+          {"counts", timing.counts},
+          {"max_us", rounded(static_cast<double>(timing.max_ns) / 1000.0, 0.1)}};
 }
 
-nlohmann::json bins(const TimingBins& timing) {
-  return {{"bin_us", TimingBins::kBinUs}, {"counts", timing.counts}, {"max_us", rounded(static_cast<double>(timing.max_ns) / 1000.0, 0.1)}};
+std::string text_of(const nlohmann::json& value) {
+  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
 
 }  // namespace
 
-StockGrid coarse_stock(const control::CommandedStock& model) {
-  StockGrid grid;
-  if (!model.ready() || model.columns() <= 0 || model.rows() <= 0) {
-    return grid;
+LiveState::LiveState() { link_detail_ = "no controller yet"; }
+
+void LiveState::set_link(display_link::LinkState state, const std::string& detail) {
+  link_ = state;
+  link_detail_ = detail;
+}
+
+void LiveState::attach(const display_link::FeedView& feed) {
+  const display_link::FeedHeader& h = feed.header();
+  attached_ = true;
+  job_id_ = h.job_id;
+  triangles_ = h.triangle_count;
+  reachable_ = h.reachable_triangle_count;
+  limits_ = h.limits;
+  reset_rule_ = h.reset_rule;
+  virtual_clock_ = h.virtual_clock != 0;
+  program_.assign(h.program, strnlen(h.program, sizeof h.program));
+  figures_ = display_link::Figures{};
+  touched_bits_.assign((triangles_ + 7) / 8, 0);
+  touched_sent_ = touched_bits_;
+  new_touched_.clear();
+  force_peak_n_ = 0.0F;
+  force_cycle_ = 0;
+  stock_sequence_ = 0;
+  grid_ = grid_sent_ = display_link::StockGridHeader{};
+  heights_.clear();
+  heights_sent_.clear();
+  nlohmann::json vertices = nlohmann::json::array();
+  nlohmann::json reachable = nlohmann::json::array();
+  for (std::uint32_t t = 0; t < triangles_; ++t) {
+    const float* v = feed.vertices(t);
+    for (int i = 0; i < 9; ++i) {
+      vertices.push_back(rounded(static_cast<double>(v[i]), 1e-4));
+    }
+    reachable.push_back((feed.flags(t) & tables::kTriangleReachable) != 0 ? 1 : 0);
   }
-  const int longer = std::max(model.columns(), model.rows());
-  const int factor = std::max(1, (longer + 99) / 100);
-  grid.columns = (model.columns() + factor - 1) / factor;
-  grid.rows = (model.rows() + factor - 1) / factor;
-  grid.cell_mm = model.cell_mm() * factor;
-  grid.x0_mm = model.block().low_mm.x();
-  grid.y0_mm = model.block().low_mm.y();
-  grid.heights_mm.assign(static_cast<std::size_t>(grid.columns) * static_cast<std::size_t>(grid.rows),
-                         static_cast<float>(model.block().high_mm.z()));
-  // Every third model cell in each direction is enough: the narrowest cut is a tool's width, many
-  // model cells wide; this keeps the sampling to about a millisecond on the machine side's thread.
-  const int stride = std::max(1, factor / 3);
-  for (int row = 0; row < model.rows(); row += stride) {
-    for (int column = 0; column < model.columns(); column += stride) {
-      float& cell = grid.heights_mm[static_cast<std::size_t>(row / factor) * static_cast<std::size_t>(grid.columns) +
-                                    static_cast<std::size_t>(column / factor)];
-      cell = std::min(cell, static_cast<float>(model.height(column, row)));
+  part_json_ = text_of({{"triangles", triangles_},
+                        {"job", std::to_string(job_id_)},
+                        {"vertices", std::move(vertices)},
+                        {"reachable", std::move(reachable)},
+                        {"tool_diameter_mm", h.tool_diameter_mm},
+                        {"workspace_mm", {h.workspace_mm[0], h.workspace_mm[1], h.workspace_mm[2]}}});
+}
+
+void LiveState::update(const display_link::FeedView* feed, std::uint64_t feed_generation) {
+  if (feed == nullptr) {
+    return;
+  }
+  if (!attached_ || feed_generation != generation_) {
+    attach(*feed);
+    generation_ = feed_generation;
+  }
+  display_link::Figures now{};
+  if (feed->read(now)) {
+    figures_ = now;
+  }
+  feed->touched(touched_bits_);
+  for (std::size_t byte = 0; byte < touched_bits_.size(); ++byte) {
+    const auto added = static_cast<std::uint8_t>(touched_bits_[byte] & ~touched_sent_[byte]);
+    for (int bit = 0; added != 0 && bit < 8; ++bit) {
+      if ((added & (1U << bit)) != 0) {
+        new_touched_.push_back(static_cast<std::uint32_t>(byte * 8 + static_cast<std::size_t>(bit)));
+      }
+    }
+    touched_sent_[byte] |= touched_bits_[byte];
+  }
+  if (figures_.have_record != 0) {
+    force_peak_n_ = std::max(force_peak_n_, feed->force_peak(force_cycle_, figures_.cycle));
+    force_cycle_ = figures_.cycle;
+  }
+  const std::uint64_t sequence = feed->stock_sequence();
+  if (sequence != stock_sequence_) {
+    auto stock = std::make_unique<display_link::FeedStock>();
+    if (feed->read(*stock) && stock->grid.columns >= 0 && stock->grid.rows >= 0 &&
+        std::int64_t{stock->grid.columns} * stock->grid.rows <= display_link::kStockCellsMax) {
+      stock_sequence_ = sequence;
+      grid_ = stock->grid;
+      heights_.assign(stock->heights_mm, stock->heights_mm + grid_.columns * grid_.rows);
     }
   }
-  return grid;
-}
-
-void TimingBins::add(std::int64_t ns) {
-  const double us = static_cast<double>(std::max<std::int64_t>(ns, 0)) / 1000.0;
-  const int bin = std::min(kBins - 1, static_cast<int>(us / kBinUs));
-  ++counts[static_cast<std::size_t>(bin)];
-  max_ns = std::max(max_ns, ns);
-}
-
-LiveState::LiveState(const tables::PartTables& part, const control::ControllerConfig& config, const HmiLimits& limits)
-    : part_(part), config_(config), limits_(limits), touched_(std::make_unique<engine::TriangleSet>()) {
-  contact_tool_ready_ = engine::build_contact_tool(part.tool.spec, control::touch_distance_mm(config), contact_tool_);
-  touched_->observe(&LiveState::heard_touched, this);
-  telemetry_.coupling_n_per_device_mm = config.haptic.coupling_n_per_device_mm;
-  telemetry_.force_limit_n = config.haptic.max_force_n;
-  telemetry_.speed_limit_mm_per_s = config.max_axis_move_mm / config.period_s;
-}
-
-void LiveState::heard_touched(void* self, std::uint32_t id) {
-  auto& state = *static_cast<LiveState*>(self);
-  state.new_touched_.push_back(id);
-  if (id < state.part_.triangle_count() && (state.part_.triangle_flags[id] & tables::kTriangleReachable) != 0) {
-    ++state.reachable_touched_;
-  }
-}
-
-void LiveState::seed_touched(const engine::TriangleSet& touched) {
-  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
-    if (touched.contains(t)) {
-      touched_->insert(t);
-    }
-  }
-}
-
-void LiveState::on_record(const control::JournalRecord& record) {
-  if (!have_record_) {
-    first_time_ns_ = record.time_ns;
-    have_record_ = true;
-  }
-  // The cycle marks the touched set at the virtual tool each cycle; where its count grew, the same
-  // marking here gives the same triangles (a cycle whose count did not grow added none).
-  if (record.touched_triangles > touched_->count() && contact_tool_ready_) {
-    const Eigen::Vector3d tip(record.virtual_tip_mm[0], record.virtual_tip_mm[1], record.virtual_tip_mm[2]);
-    static_cast<void>(engine::mark_touched(part_, contact_tool_, {tip, Eigen::Vector3d::UnitZ()},
-                                           control::touch_distance_mm(config_), *touched_));
-  }
-  const Eigen::Vector3d f(static_cast<double>(record.force_n[0]), static_cast<double>(record.force_n[1]),
-                          static_cast<double>(record.force_n[2]));
-  const double force = f.norm();
-  force_peak_n_ = std::max(force_peak_n_, force);
-  last_record_ = record;
-}
-
-void LiveState::on_telemetry(const control::Telemetry& telemetry) {
-  if (have_telemetry_ && telemetry.cycle > telemetry_.cycle + 1) {
-    telemetry_gaps_ += telemetry.cycle - telemetry_.cycle - 1;  // dropped by a full ring
-  }
-  wakeup_.add(telemetry.wakeup_ns);
-  if (telemetry.cycle > 1) {
-    compute_.add(telemetry.last_compute_ns);
-  }
-  telemetry_ = telemetry;
-  have_telemetry_ = true;
-  ++telemetry_seen_;
-}
-
-void LiveState::on_machine(double lag_mm, StockGrid stock) {
-  lag_mm_ = lag_mm;
-  stock_ = std::move(stock);
 }
 
 double LiveState::coverage() const {
-  if (part_.header.reachable_triangle_count == 0) {
-    return 1.0;
+  if (reachable_ == 0) {
+    return attached_ ? 1.0 : 0.0;
   }
-  return static_cast<double>(reachable_touched_) / static_cast<double>(part_.header.reachable_triangle_count);
+  return static_cast<double>(figures_.reachable_touched) / static_cast<double>(reachable_);
 }
 
 std::string LiveState::reset_refusal() const {
-  if (!have_telemetry_ || telemetry_.safe_reason == control::SafeReason::None) {
-    return "not in a safe state";
+  if (!attached_) {
+    return "no controller";
   }
-  if (telemetry_.device_still_s < config_.still_time_s) {
-    return "hold the handle still (" + std::to_string(static_cast<int>(config_.still_time_s * 1000)) + " ms)";
+  if (figures_.phase == display_link::JobPhase::Ended) {
+    return "the job has ended";
   }
-  if (telemetry_.device_to_tool_mm > config_.reset_distance_mm) {
-    char text[120];
-    std::snprintf(text, sizeof text, "bring the handle to the virtual tool: %.1f mm away, at most %.1f mm",
-                  telemetry_.device_to_tool_mm, config_.reset_distance_mm);
-    return text;
+  return display_link::reset_refusal(figures_.have_telemetry != 0, figures_.telemetry, reset_rule_);
+}
+
+nlohmann::json LiveState::stock_grid(const display_link::StockGridHeader& g, const std::vector<float>& heights) {
+  nlohmann::json values = nlohmann::json::array();
+  for (const float h : heights) {
+    values.push_back(rounded(static_cast<double>(h), 1e-3));
   }
-  return "";
+  return {{"x0", g.x0_mm}, {"y0", g.y0_mm}, {"cell", g.cell_mm}, {"columns", g.columns}, {"rows", g.rows},
+          {"heights", std::move(values)}};
 }
 
 void LiveState::common(nlohmann::json& out) const {
-  const control::JournalRecord& r = last_record_;
-  out["t"] = rounded(static_cast<double>(r.time_ns - first_time_ns_) / 1e9, 1e-3);
-  out["cycle"] = r.cycle;
-  out["tool"] = point(r.virtual_tip_mm);
-  out["probe"] = point(motion::device_to_world(config_.frames, Eigen::Vector3d(r.device_mm[0], r.device_mm[1], r.device_mm[2])));
-  out["force"] = nlohmann::json::array(
-      {rounded(static_cast<double>(r.force_n[0]), 1e-3), rounded(static_cast<double>(r.force_n[1]), 1e-3),
-       rounded(static_cast<double>(r.force_n[2]), 1e-3)});
-  out["touched_count"] = touched_->count();
+  const display_link::Figures& f = figures_;
+  const control::Telemetry& telemetry = f.telemetry;
+  out["controller"] = {{"state", display_link::link_state_name(link_)},
+                       {"detail", link_detail_},
+                       {"program", program_},
+                       {"job", std::to_string(job_id_)},
+                       {"ended", f.phase == display_link::JobPhase::Ended},
+                       {"end", std::string(f.end_text, strnlen(f.end_text, sizeof f.end_text))}};
+  out["t"] = rounded(static_cast<double>(f.time_ns - f.first_time_ns) / 1e9, 1e-3);
+  out["cycle"] = f.cycle;
+  out["tool"] = point(f.virtual_tip_mm);
+  out["probe"] = point(f.probe_mm);
+  out["force"] = nlohmann::json::array({rounded(static_cast<double>(f.force_n[0]), 1e-3),
+                                        rounded(static_cast<double>(f.force_n[1]), 1e-3),
+                                        rounded(static_cast<double>(f.force_n[2]), 1e-3)});
+  out["touched_count"] = f.touched_count;
   out["coverage"] = rounded(coverage(), 1e-5);
-  out["lag_mm"] = rounded(lag_mm_, 1e-3);
-  const control::SafeReason reason = have_telemetry_ ? telemetry_.safe_reason : r.safe_reason;
+  out["lag_mm"] = rounded(grid_.lag_mm, 1e-3);
+  const control::SafeReason reason = f.have_telemetry != 0 ? telemetry.safe_reason : f.record_safe_reason;
   const std::string refusal = reset_refusal();
   out["safe"] = {{"active", reason != control::SafeReason::None},
                  {"reason", control::safe_reason_name(reason)},
                  {"reset_allowed", refusal.empty()},
                  {"reset_refusal", refusal},
-                 {"reset_requests", telemetry_.reset_requests},
-                 {"last_reset", control::reset_outcome_name(telemetry_.last_reset)}};
-  out["params"] = {{"coupling", rounded(telemetry_.coupling_n_per_device_mm, 1e-4)},
-                   {"force_limit", rounded(telemetry_.force_limit_n, 1e-4)},
-                   {"speed_limit", std::isfinite(telemetry_.speed_limit_mm_per_s)
-                                       ? nlohmann::json(rounded(telemetry_.speed_limit_mm_per_s, 1e-4))
+                 {"reset_requests", telemetry.reset_requests},
+                 {"last_reset", control::reset_outcome_name(telemetry.last_reset)}};
+  out["params"] = {{"coupling", rounded(telemetry.coupling_n_per_device_mm, 1e-4)},
+                   {"force_limit", rounded(telemetry.force_limit_n, 1e-4)},
+                   {"speed_limit", std::isfinite(telemetry.speed_limit_mm_per_s)
+                                       ? nlohmann::json(rounded(telemetry.speed_limit_mm_per_s, 1e-4))
                                        : nlohmann::json(nullptr)},
-                   {"requests", telemetry_.parameter_requests},
-                   {"last", control::parameter_name(telemetry_.last_parameter)},
-                   {"last_outcome", control::parameter_outcome_name(telemetry_.last_parameter_outcome)}};
+                   {"requests", telemetry.parameter_requests},
+                   {"last", control::parameter_name(telemetry.last_parameter)},
+                   {"last_outcome", control::parameter_outcome_name(telemetry.last_parameter_outcome)}};
+  const display_link::RequestCounters& r = f.requests;
+  out["link"] = {{"displays", r.displays_connected}, {"accepted", r.accepted}, {"refused", r.refused},
+                 {"rate_limited", r.rate_limited},  {"malformed", r.malformed}, {"peers_refused", r.peers_refused}};
 }
 
 nlohmann::json LiveState::frame(std::uint64_t sequence, const nlohmann::json& server) {
   nlohmann::json out;
+  if (!attached_) {
+    out = {{"type", "waiting"},
+           {"seq", sequence},
+           {"controller", {{"state", display_link::link_state_name(link_)}, {"detail", link_detail_}}},
+           {"server", server}};
+    return out;
+  }
   out["type"] = "frame";
   out["seq"] = sequence;
   common(out);
-  out["force_peak"] = rounded(force_peak_n_, 1e-3);
+  out["force_peak"] = rounded(static_cast<double>(force_peak_n_), 1e-3);
   out["touched"] = new_touched_;
   // Stock cells that changed by more than a micrometre since the last frame: [index, height].
   nlohmann::json cells = nlohmann::json::array();
-  if (stock_sent_.heights_mm.size() != stock_.heights_mm.size()) {
-    out["stock_grid"] = {{"x0", stock_.x0_mm}, {"y0", stock_.y0_mm}, {"cell", stock_.cell_mm},
-                         {"columns", stock_.columns}, {"rows", stock_.rows}, {"heights", nlohmann::json::array()}};
-    for (const float h : stock_.heights_mm) {
-      out["stock_grid"]["heights"].push_back(rounded(static_cast<double>(h), 1e-3));
-    }
+  if (heights_sent_.size() != heights_.size() || grid_sent_.columns != grid_.columns) {
+    out["stock_grid"] = stock_grid(grid_, heights_);
   } else {
-    for (std::size_t i = 0; i < stock_.heights_mm.size(); ++i) {
-      if (std::abs(stock_.heights_mm[i] - stock_sent_.heights_mm[i]) > 1e-3F) {
-        cells.push_back({i, rounded(static_cast<double>(stock_.heights_mm[i]), 1e-3)});
+    for (std::size_t i = 0; i < heights_.size(); ++i) {
+      if (std::abs(heights_[i] - heights_sent_[i]) > 1e-3F) {
+        cells.push_back({i, rounded(static_cast<double>(heights_[i]), 1e-3)});
       }
     }
   }
   out["stock"] = std::move(cells);
   // The loop's histograms change slowly: once a second.
   if (frames_ % 20 == 0) {
-    out["loop"] = {{"wakeup", bins(wakeup_)}, {"compute", bins(compute_)}, {"telemetry_gaps", telemetry_gaps_}};
+    out["loop"] = {{"wakeup", bins(figures_.wakeup)}, {"compute", bins(figures_.compute)},
+                   {"telemetry_gaps", figures_.telemetry_gaps}};
   }
   out["server"] = server;
   new_touched_.clear();
-  force_peak_n_ = 0.0;
-  stock_sent_ = stock_;
+  force_peak_n_ = 0.0F;
+  heights_sent_ = heights_;
+  grid_sent_ = grid_;
   ++frames_;
   return out;
 }
 
 nlohmann::json LiveState::snapshot(std::uint64_t sequence, const nlohmann::json& server) const {
+  if (!attached_) {
+    nlohmann::json out = {{"type", "waiting"},
+                          {"seq", sequence},
+                          {"controller", {{"state", display_link::link_state_name(link_)}, {"detail", link_detail_}}},
+                          {"server", server}};
+    return out;
+  }
   nlohmann::json out;
   out["type"] = "snapshot";
   out["seq"] = sequence;
   common(out);
   out["force_peak"] = 0.0;
+  // Built after the tick's frame: everything as of now; the next frame's changes apply on top.
   std::vector<std::uint32_t> ids;
-  ids.reserve(touched_->count());
-  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
-    if (touched_->contains(t)) {
-      ids.push_back(t);
+  for (std::size_t byte = 0; byte < touched_sent_.size(); ++byte) {
+    for (int bit = 0; bit < 8; ++bit) {
+      const auto id = static_cast<std::uint32_t>(byte * 8 + static_cast<std::size_t>(bit));
+      if ((touched_sent_[byte] & (1U << bit)) != 0) {
+        ids.push_back(id);
+      }
     }
   }
   out["touched"] = std::move(ids);
-  // As the last frame left the clients: the next frame's changes apply on top of this.
-  nlohmann::json heights = nlohmann::json::array();
-  for (const float h : stock_sent_.heights_mm) {
-    heights.push_back(rounded(static_cast<double>(h), 1e-3));
-  }
-  out["stock_grid"] = {{"x0", stock_sent_.x0_mm}, {"y0", stock_sent_.y0_mm}, {"cell", stock_sent_.cell_mm},
-                       {"columns", stock_sent_.columns}, {"rows", stock_sent_.rows}, {"heights", std::move(heights)}};
+  out["stock_grid"] = stock_grid(grid_sent_, heights_sent_);
   out["stock"] = nlohmann::json::array();
-  out["loop"] = {{"wakeup", bins(wakeup_)}, {"compute", bins(compute_)}, {"telemetry_gaps", telemetry_gaps_}};
+  out["loop"] = {{"wakeup", bins(figures_.wakeup)}, {"compute", bins(figures_.compute)},
+                 {"telemetry_gaps", figures_.telemetry_gaps}};
   out["limits"] = {{"board_force_limit", limits_.board_force_limit_n},
                    {"mill_speed", limits_.mill_speed_mm_per_s},
                    {"min_coupling", limits_.min_coupling_n_per_device_mm},
                    {"max_coupling", limits_.max_coupling_n_per_device_mm}};
+  out["virtual_clock"] = virtual_clock_;
   out["server"] = server;
   return out;
-}
-
-nlohmann::json LiveState::part_mesh() const {
-  nlohmann::json vertices = nlohmann::json::array();
-  nlohmann::json reachable = nlohmann::json::array();
-  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
-    for (const tables::PackedPoint& v : part_.triangles[t].vertices) {
-      vertices.push_back(rounded(static_cast<double>(v.x_mm), 1e-4));
-      vertices.push_back(rounded(static_cast<double>(v.y_mm), 1e-4));
-      vertices.push_back(rounded(static_cast<double>(v.z_mm), 1e-4));
-    }
-    reachable.push_back((part_.triangle_flags[t] & tables::kTriangleReachable) != 0 ? 1 : 0);
-  }
-  return {{"triangles", part_.triangle_count()},
-          {"vertices", std::move(vertices)},
-          {"reachable", std::move(reachable)},
-          {"tool_diameter_mm", part_.tool.spec.diameter_mm},
-          {"workspace_mm", {part_.header.workspace_mm[0], part_.header.workspace_mm[1], part_.header.workspace_mm[2]}}};
 }
 
 }  // namespace stencil::hmi

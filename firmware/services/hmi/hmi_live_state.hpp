@@ -1,100 +1,77 @@
-// What the operator display shows, gathered from the records the cycle already publishes (every
-// journal record, the telemetry, the machine side's lag and stock model) and turned into JSON
-// frames: deltas at 20 Hz, and a whole snapshot for a client that is new or missed a frame.
-//
-// Not thread-safe by itself: HmiServer holds it under its lock. Never touched by the cycle.
+// What the operator display shows, read from a controller's state feed at each tick and turned into
+// JSON frames: deltas at 20 Hz, and a whole snapshot for a client that is new or missed a frame.
+// Lives in stencil-display only; not thread-safe by itself (the web server's one thread owns it).
 #pragma once
 
-#include <array>
 #include <cstdint>
-#include <memory>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "firmware/core/control/commanded_stock.hpp"
-#include "firmware/core/control/controller.hpp"
-#include "firmware/core/control/cycle_messages.hpp"
-#include "firmware/services/hmi/hmi_requests.hpp"
-#include "firmware/core/motion/machine_frames.hpp"
-#include "firmware/core/stencil/triangle_set.hpp"
-#include "firmware/core/tables/part_tables.hpp"
+#include "firmware/services/display_link/controller_client.hpp"
+#include "firmware/services/display_link/display_wire.hpp"
+#include "firmware/services/display_link/state_feed.hpp"
 
 namespace stencil::hmi {
 
-// The stock as machined, coarse enough to send: the lowest height of the model's cells sampled
-// under each display cell, row-major from the block's low corner.
-struct StockGrid {
-  double x0_mm = 0.0, y0_mm = 0.0, cell_mm = 0.0;
-  int columns = 0, rows = 0;
-  std::vector<float> heights_mm;
-};
-
-// At most about 100 display cells along the block's longer side (and no finer than the model).
-[[nodiscard]] StockGrid coarse_stock(const control::CommandedStock& model);
-
-// Loop timing in 10 us bins up to 500 us, the last bin everything longer.
-struct TimingBins {
-  static constexpr int kBins = 51;
-  static constexpr double kBinUs = 10.0;
-  std::array<std::uint64_t, kBins> counts{};
-  std::int64_t max_ns = 0;
-  void add(std::int64_t ns);
-};
-
 class LiveState {
  public:
-  LiveState(const tables::PartTables& part, const control::ControllerConfig& config, const HmiLimits& limits);
+  LiveState();
 
-  // Every cycle's record, in order (lossless): tool, probe, force, touched set, safe state.
-  void on_record(const control::JournalRecord& record);
-  // Telemetry (may have gaps): loop timing, parameters, reset state.
-  void on_telemetry(const control::Telemetry& telemetry);
-  // The machine side's newest lag and the stock as it models it.
-  void on_machine(double lag_mm, StockGrid stock);
-  // Before the cycle starts: a resumed job's touched set, rebuilt from its journal.
-  void seed_touched(const engine::TriangleSet& touched);
+  // At each tick, with the controller's feed (null: none yet). A feed of a new job starts everything
+  // again from it; the same feed's newest state is read (touched triangles as deltas, the stock only
+  // when it changed, the largest force since the last tick).
+  void update(const display_link::FeedView* feed, std::uint64_t feed_generation);
+  // Where the link stands, for the page (shown with every frame).
+  void set_link(display_link::LinkState state, const std::string& detail);
 
+  [[nodiscard]] bool has_feed() const { return attached_; }
   // What changed since the last frame(), as one frame; advances. `server` is the server's own
   // counters, sent as they are.
   [[nodiscard]] nlohmann::json frame(std::uint64_t sequence, const nlohmann::json& server);
   // Everything as of the last frame(): a client starts (or starts again) from this.
   [[nodiscard]] nlohmann::json snapshot(std::uint64_t sequence, const nlohmann::json& server) const;
-  // The part's mesh and which triangles are reachable (GET /api/part), built once.
-  [[nodiscard]] nlohmann::json part_mesh() const;
+  // The part's mesh and which triangles are reachable (GET /api/part), built once per job.
+  [[nodiscard]] const std::string& part_json() const { return part_json_; }
 
-  // Why a reset may not be asked now ("" when it may): the server's decision; the cycle's rule has
-  // the last word.
+  // Why a reset may not be asked now ("" when it may): the display's decision; the controller and
+  // then the cycle check again.
   [[nodiscard]] std::string reset_refusal() const;
+  [[nodiscard]] const display_link::RequestLimits& limits() const { return limits_; }
 
   [[nodiscard]] double coverage() const;
-  [[nodiscard]] std::size_t touched_count() const { return touched_->count(); }
+  [[nodiscard]] std::uint32_t touched_count() const { return figures_.touched_count; }
+  [[nodiscard]] std::uint64_t job_id() const { return job_id_; }
+  [[nodiscard]] bool virtual_clock() const { return virtual_clock_; }
+  [[nodiscard]] const display_link::Figures& figures() const { return figures_; }
 
  private:
-  static void heard_touched(void* self, std::uint32_t id);
+  void attach(const display_link::FeedView& feed);
   void common(nlohmann::json& out) const;
+  [[nodiscard]] static nlohmann::json stock_grid(const display_link::StockGridHeader& grid, const std::vector<float>& heights);
 
-  const tables::PartTables& part_;
-  control::ControllerConfig config_;
-  HmiLimits limits_;
-  geometry::ToolBsp contact_tool_{};
-  bool contact_tool_ready_ = false;
-  std::unique_ptr<engine::TriangleSet> touched_;  // the mirror of the cycle's set
-  std::vector<std::uint32_t> new_touched_;        // added since the last frame
-  std::uint32_t reachable_touched_ = 0;
+  bool attached_ = false;
+  std::uint64_t generation_ = 0;
+  std::uint64_t job_id_ = 0;
+  std::uint32_t triangles_ = 0, reachable_ = 0;
+  display_link::RequestLimits limits_{};
+  display_link::ResetRule reset_rule_{};
+  bool virtual_clock_ = false;
+  std::string program_;
+  std::string part_json_;
 
-  bool have_record_ = false;
-  std::int64_t first_time_ns_ = 0;
-  control::JournalRecord last_record_{};
-  double force_peak_n_ = 0.0;                     // since the last frame
-  control::Telemetry telemetry_{};
-  bool have_telemetry_ = false;
-  std::uint64_t telemetry_seen_ = 0, telemetry_gaps_ = 0;
-  TimingBins wakeup_, compute_;
-  double lag_mm_ = 0.0;
-  StockGrid stock_, stock_sent_;                  // now, and as the last frame left the clients
+  display_link::LinkState link_ = display_link::LinkState::Waiting;
+  std::string link_detail_;
+
+  display_link::Figures figures_{};
+  std::vector<std::uint8_t> touched_bits_, touched_sent_;  // now, and as the last frame left the clients
+  std::vector<std::uint32_t> new_touched_;                 // since the last frame
+  float force_peak_n_ = 0.0F;                              // since the last frame
+  std::uint64_t force_cycle_ = 0;                          // the newest cycle the peak has seen
+  std::uint64_t stock_sequence_ = 0;
+  display_link::StockGridHeader grid_{}, grid_sent_{};
+  std::vector<float> heights_, heights_sent_;
   std::uint64_t frames_ = 0;
 };
 

@@ -6,40 +6,6 @@
 #include <nlohmann/json.hpp>
 
 namespace stencil::hmi {
-namespace {
-
-std::string number(double value) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%g", value);
-  return text;
-}
-
-}  // namespace
-
-const char* parameter_unit(Parameter parameter) {
-  switch (parameter) {
-    case Parameter::Coupling:
-      return "N/mm";
-    case Parameter::ForceLimit:
-      return "N";
-    case Parameter::SpeedLimit:
-      return "mm/s";
-  }
-  return "";
-}
-
-control::CommandKind command_kind(Parameter parameter) {
-  switch (parameter) {
-    case Parameter::Coupling:
-      return control::CommandKind::SetCoupling;
-    case Parameter::ForceLimit:
-      return control::CommandKind::SetForceLimit;
-    case Parameter::SpeedLimit:
-      return control::CommandKind::SetSpeedLimit;
-  }
-  return control::CommandKind::SetCoupling;
-}
-
 bool parse_request(std::string_view text, Request& request, std::string& error) {
   if (text.size() > kMaxRequestBytes) {
     error = "message of " + std::to_string(text.size()) + " bytes: at most " + std::to_string(kMaxRequestBytes);
@@ -86,37 +52,6 @@ bool parse_request(std::string_view text, Request& request, std::string& error) 
   }
   request = Request{RequestKind::Set, parameter, message["value"].get<double>()};
   return true;
-}
-
-std::string refusal(const Request& request, const HmiLimits& limits) {
-  if (request.kind != RequestKind::Set) {
-    return "";
-  }
-  const double value = request.value;
-  const std::string unit = parameter_unit(request.parameter);
-  if (!std::isfinite(value) || value <= 0.0) {
-    return std::string(control::parameter_name(command_kind(request.parameter))) + " must be a positive number of " + unit;
-  }
-  switch (request.parameter) {
-    case Parameter::Coupling:
-      if (value < limits.min_coupling_n_per_device_mm || value > limits.max_coupling_n_per_device_mm) {
-        return number(value) + " N/mm is outside the coupling's range of " + number(limits.min_coupling_n_per_device_mm) +
-               " to " + number(limits.max_coupling_n_per_device_mm) + " N/mm";
-      }
-      break;
-    case Parameter::ForceLimit:
-      if (value > limits.board_force_limit_n) {
-        return number(value) + " N is above the board's force limit of " + number(limits.board_force_limit_n) +
-               " N (the operator must always be able to overpower the device)";
-      }
-      break;
-    case Parameter::SpeedLimit:
-      if (value > limits.mill_speed_mm_per_s) {
-        return number(value) + " mm/s is above what the mill follows, " + number(limits.mill_speed_mm_per_s) + " mm/s";
-      }
-      break;
-  }
-  return "";
 }
 
 }  // namespace stencil::hmi

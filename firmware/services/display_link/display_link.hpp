@@ -1,0 +1,77 @@
+// The controller's side of its displays: a control::DisplayFeed that keeps the state feed (the
+// records thread's figures and touched set, the machine thread's stock) and serves the request
+// channel. It runs in the controller's process and holds nothing that faces a network: the
+// displays (stencil-display) are processes of their own that reach it only through the socket.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "firmware/core/control/controller.hpp"
+#include "firmware/core/control/display_feed.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/stencil/triangle_set.hpp"
+#include "firmware/core/tables/part_tables.hpp"
+#include "firmware/services/display_link/request_server.hpp"
+#include "firmware/services/display_link/state_feed.hpp"
+
+namespace stencil::display_link {
+
+struct DisplayLinkOptions {
+  std::string socket_path;
+  std::string program;         // "stencil-sim", shown by the display
+  bool virtual_clock = false;  // the cycle runs on a virtual clock: its loop timing is 0 by construction
+};
+
+[[nodiscard]] RequestLimits limits_of(const control::ControllerConfig& config);
+
+// The stock as machined, coarse enough to show: the lowest height of the model's cells sampled
+// under each display cell (at most ~100 a side).
+void coarse_stock(const control::CommandedStock& model, FeedStock& stock);
+
+class DisplayLink final : public control::DisplayFeed {
+ public:
+  DisplayLink(const tables::PartTables& part, const control::ControllerConfig& config, DisplayLinkOptions options);
+  ~DisplayLink();
+  DisplayLink(const DisplayLink&) = delete;
+  DisplayLink& operator=(const DisplayLink&) = delete;
+
+  // The feed created and filled, the socket bound and served; false with the reason.
+  [[nodiscard]] bool start(std::string& error);
+  // The job is over: the displays show how, with the last state. Then stop() closes the socket.
+  void end(const std::string& how);
+  void stop();
+
+  // control::DisplayFeed, from the boards' threads.
+  void on_record(const control::JournalRecord& record) override;
+  void on_telemetry(const control::Telemetry& telemetry) override;
+  void on_machine(double lag_mm, const control::CommandedStock& model) override;
+  void seed_touched(const engine::TriangleSet& touched) override;
+  [[nodiscard]] bool pop_command(control::Command& command) override;
+
+  [[nodiscard]] RequestCounters counters() const;
+  [[nodiscard]] const std::string& socket_path() const { return options_.socket_path; }
+  [[nodiscard]] int feed_fd() const { return feed_.fd(); }
+
+ private:
+  static void heard_touched(void* self, std::uint32_t id);
+  [[nodiscard]] std::string decide(const Request& request) const;
+  void publish(bool now);
+
+  const tables::PartTables& part_;
+  control::ControllerConfig config_;
+  DisplayLinkOptions options_;
+  geometry::ToolBsp contact_tool_{};
+  bool contact_tool_ready_ = false;
+  std::unique_ptr<engine::TriangleSet> touched_;  // the mirror of the cycle's set
+  std::unique_ptr<Figures> figures_;              // the records thread's, published behind the seqlock
+  std::unique_ptr<FeedStock> stock_;              // the machine thread's
+  std::chrono::steady_clock::time_point published_{}, sampled_{};
+  FeedWriter feed_;
+  FeedView own_view_;  // the reset rule reads the newest telemetry back from the feed: no lock
+  std::unique_ptr<RequestServer> server_;
+};
+
+}  // namespace stencil::display_link

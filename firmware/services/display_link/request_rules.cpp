@@ -1,0 +1,95 @@
+#include "firmware/services/display_link/request_rules.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "firmware/core/control/safe_state.hpp"
+
+namespace stencil::display_link {
+namespace {
+
+std::string number(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+}  // namespace
+
+const char* parameter_unit(Parameter parameter) {
+  switch (parameter) {
+    case Parameter::Coupling:
+      return "N/mm";
+    case Parameter::ForceLimit:
+      return "N";
+    case Parameter::SpeedLimit:
+      return "mm/s";
+  }
+  return "";
+}
+
+control::CommandKind command_kind(Parameter parameter) {
+  switch (parameter) {
+    case Parameter::Coupling:
+      return control::CommandKind::SetCoupling;
+    case Parameter::ForceLimit:
+      return control::CommandKind::SetForceLimit;
+    case Parameter::SpeedLimit:
+      return control::CommandKind::SetSpeedLimit;
+  }
+  return control::CommandKind::SetCoupling;
+}
+
+control::Command command_of(const Request& request) {
+  return request.kind == RequestKind::Reset ? control::Command{control::CommandKind::Reset, 0.0}
+                                            : control::Command{command_kind(request.parameter), request.value};
+}
+
+std::string refusal(const Request& request, const RequestLimits& limits) {
+  if (request.kind != RequestKind::Set) {
+    return "";
+  }
+  const double value = request.value;
+  const std::string unit = parameter_unit(request.parameter);
+  if (!std::isfinite(value) || value <= 0.0) {
+    return std::string(control::parameter_name(command_kind(request.parameter))) + " must be a positive number of " + unit;
+  }
+  switch (request.parameter) {
+    case Parameter::Coupling:
+      if (value < limits.min_coupling_n_per_device_mm || value > limits.max_coupling_n_per_device_mm) {
+        return number(value) + " N/mm is outside the coupling's range of " + number(limits.min_coupling_n_per_device_mm) +
+               " to " + number(limits.max_coupling_n_per_device_mm) + " N/mm";
+      }
+      break;
+    case Parameter::ForceLimit:
+      if (value > limits.board_force_limit_n) {
+        return number(value) + " N is above the board's force limit of " + number(limits.board_force_limit_n) +
+               " N (the operator must always be able to overpower the device)";
+      }
+      break;
+    case Parameter::SpeedLimit:
+      if (value > limits.mill_speed_mm_per_s) {
+        return number(value) + " mm/s is above what the mill follows, " + number(limits.mill_speed_mm_per_s) + " mm/s";
+      }
+      break;
+  }
+  return "";
+}
+
+std::string reset_refusal(bool have, const control::Telemetry& telemetry, const ResetRule& rule) {
+  if (!have || telemetry.safe_reason == control::SafeReason::None) {
+    return "not in a safe state";
+  }
+  if (telemetry.device_still_s < rule.still_time_s) {
+    return "hold the handle still (" + std::to_string(static_cast<int>(rule.still_time_s * 1000)) + " ms)";
+  }
+  if (telemetry.device_to_tool_mm > rule.reset_distance_mm) {
+    char text[120];
+    std::snprintf(text, sizeof text, "bring the handle to the virtual tool: %.1f mm away, at most %.1f mm",
+                  telemetry.device_to_tool_mm, rule.reset_distance_mm);
+    return text;
+  }
+  return "";
+}
+
+}  // namespace stencil::display_link
