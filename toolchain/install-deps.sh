@@ -2,7 +2,7 @@
 # Installs exactly the Debian packages the project builds and tests with; does nothing when all are present.
 # --cross also installs the aarch64-linux-gnu cross compiler and the arm64 libraries the firmware
 # links (zlib), for the `aarch64` preset and its stencil-rig (CLI11 and nlohmann json are header-only:
-# the host's copies serve; without libcivetweb-dev:arm64 the cross-built stencil-rig has no --hmi).
+# the host's copies serve; stencil-display, with Boost.Beast, is a host program).
 # --latency adds cyclictest and stress-ng for make latency.
 # --fresh-check adds mmdebstrap, for make fresh-check.
 set -euo pipefail
@@ -43,7 +43,7 @@ packages=(
   clang              # the fuzz preset's compiler (libFuzzer needs clang)
   libclang-rt-14-dev # libFuzzer and the sanitizer runtimes for clang 14 (only recommended by clang)
   clang-tidy         # make size-check: readability-function-size over the programs, runtime and boards
-  libcivetweb-dev    # the operator display's HTTP + WebSocket server (--hmi)
+  libboost-dev       # stencil-display's HTTP and WebSocket server: Boost.Beast (header-only)
   chromium           # the display's end-to-end test, headless (driven by playwright-core from npm)
   fonts-dejavu-core  # text in that browser's screenshots
 )

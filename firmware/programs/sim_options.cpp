@@ -121,7 +121,7 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     if (!o.resume_path.empty() || !o.journal_path.empty() || !o.inject_text.empty() ||
         app.count("--device-process") > 0 || o.speed == 1.0 || o.display.requested()) {
       error = "--replay runs the recorded job on the virtual clock by itself: no --resume, --journal, --inject, "
-              "--device-process, --hmi or --speed 1 with it";
+              "--device-process, --hmi, --display-socket or --speed 1 with it";
       return false;
     }
     o.fast = o.fast || o.speed == 0.0;

@@ -262,6 +262,42 @@ case_same_report_twice() {
   fi
 }
 
+# A display killed part way through a job changes nothing in it: the controller neither waits for
+# nor depends on its displays, so the report is the same as without one (apart from wall clock).
+case_killing_the_display_changes_nothing() {
+  strip_wall_clock() {
+    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+  }
+  local display socket display_pid sim_pid
+  display="$(dirname "$sim")/stencil-display"
+  socket="$PWD/display.sock"
+  "$display" --controller "$socket" --listen 127.0.0.1:0 >display.log 2>&1 &
+  display_pid=$!
+  "$sim" --fast --pattern random --seed 3 --duration 600 --no-journal --display-socket "$socket" \
+    --report with.json >with.log 2>&1 &
+  sim_pid=$!
+  for _ in $(seq 1 200); do grep -q "controller connected" display.log && break; sleep 0.02; done
+  sleep 0.3
+  if kill -0 "$sim_pid" 2>/dev/null; then
+    kill -9 "$display_pid"
+    echo "display killed while the job ran"
+  else
+    fail "the job ended before the display could be killed"
+  fi
+  wait "$display_pid" 2>/dev/null
+  wait "$sim_pid"
+  status=$?
+  sed 's/^/  display: /' display.log
+  sed 's/^/  stdout: /' with.log
+  expect_status 0
+  grep -q "display link: 1 display(s) connected" with.log || fail "the display never connected"
+  run_sim --fast --pattern random --seed 3 --duration 600 --no-journal --report without.json
+  expect_status 0
+  if ! diff <(strip_wall_clock with.json) <(strip_wall_clock without.json); then
+    fail "killing the display changed the job's report"
+  fi
+}
+
 # The simulated device reached through the real PIO shared-memory and SocketCAN code: both wires
 # carry positions to the micrometre, so the two give the same report, and neither gouges.
 case_pio_and_can_give_the_same_result() {

@@ -1,4 +1,4 @@
-// libFuzzer target: the operator display's request parser and the limits check behind it, on any
+// libFuzzer target: the operator display's (stencil-display's) request parser and the limits check behind it, on any
 // bytes a browser (or anyone on the network) could send: never a crash, an error whenever it says
 // no, and never a parameter past the board's limits let through.
 #include <cmath>
@@ -10,8 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "firmware/services/hmi/hmi_requests.hpp"
-#include "firmware/services/hmi/hmi_server.hpp"
-#include "firmware/core/tables/part_tables.hpp"
+#include "firmware/services/hmi/display_app.hpp"
 #include "tests/fuzz/fuzz_require.hpp"
 
 using stencil::fuzz::require;
@@ -19,15 +18,17 @@ using stencil::fuzz::require;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace stencil::hmi;
   const std::string_view text(reinterpret_cast<const char*>(data), size);
-  // The server's whole answer, as a client would get it: always valid JSON, never an exception.
-  static const stencil::tables::PartTables part{};
-  static HmiServer server({}, part, stencil::control::ControllerConfig{});
+  // The display's whole answer, as a browser would get it: always valid JSON, never an exception
+  // (with no controller behind it, every request it would forward is refused, with the reason).
+  static DisplayApp display([] {
+    DisplayAppOptions options;
+    options.controller_socket = "/nonexistent/display.sock";
+    options.quiet = true;
+    return options;
+  }());
   for (const bool may_control : {false, true}) {
-    const nlohmann::json answer = nlohmann::json::parse(server.handle_message(may_control, text), nullptr, false);
+    const nlohmann::json answer = nlohmann::json::parse(display.handle_message(1, may_control, text), nullptr, false);
     require(answer.is_object() && answer.contains("type"));
-  }
-  stencil::control::Command command{};
-  while (server.pop_command(command)) {
   }
   Request request;
   std::string error;

@@ -215,7 +215,8 @@ float FeedView::force_peak(std::uint64_t after_cycle, std::uint64_t newest_cycle
   const std::uint64_t ring_newest =
       std::atomic_ref<std::uint64_t>(const_cast<std::uint64_t&>(forces_->newest_cycle)).load(std::memory_order_acquire);
   const std::uint64_t last = std::min(newest_cycle, ring_newest);
-  const std::uint64_t first = std::max(after_cycle + 1, last >= kForceRing ? last - kForceRing + 1 : 0);
+  // Only the ring's newest kForceRing cycles are still there (older slots hold newer cycles).
+  const std::uint64_t first = std::max(after_cycle + 1, ring_newest >= kForceRing ? ring_newest - kForceRing + 1 : 0);
   float peak = 0.0F;
   for (std::uint64_t cycle = first; cycle <= last && last != 0; ++cycle) {
     const std::uint32_t bits = std::atomic_ref<std::uint32_t>(const_cast<std::uint32_t&>(forces_->force_bits[cycle % kForceRing]))

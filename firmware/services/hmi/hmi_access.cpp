@@ -78,19 +78,19 @@ bool is_loopback(const std::string& host) {
 bool check_access(const HmiEndpoint& endpoint, const std::string& token, std::string& error) {
   if (!token.empty()) {
     if (token.size() < 8) {
-      error = "--hmi-token: at least 8 characters";
+      error = "the token: at least 8 characters";
       return false;
     }
     for (const char c : token) {
       if (c <= ' ' || c > '~' || c == '&' || c == '#' || c == '%' || c == '?') {
-        error = "--hmi-token: printable ASCII only, without spaces or & # % ?";
+        error = "the token: printable ASCII only, without spaces or & # % ?";
         return false;
       }
     }
   }
   if (!is_loopback(endpoint.host) && token.empty()) {
-    error = "--hmi " + endpoint.host + ": listening beyond this machine needs --hmi-token T (anyone on the network "
-            "could change the force limit otherwise)";
+    error = endpoint.host + ": listening beyond this machine needs a token, from a file only its owner reads "
+            "(anyone on the network could change the force limit otherwise)";
     return false;
   }
   return true;

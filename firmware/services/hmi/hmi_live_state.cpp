@@ -145,6 +145,7 @@ void LiveState::common(nlohmann::json& out) const {
                        {"job", std::to_string(job_id_)},
                        {"ended", f.phase == display_link::JobPhase::Ended},
                        {"end", std::string(f.end_text, strnlen(f.end_text, sizeof f.end_text))}};
+  out["virtual_clock"] = virtual_clock_;
   out["t"] = rounded(static_cast<double>(f.time_ns - f.first_time_ns) / 1e9, 1e-3);
   out["cycle"] = f.cycle;
   out["tool"] = point(f.virtual_tip_mm);
@@ -248,7 +249,6 @@ nlohmann::json LiveState::snapshot(std::uint64_t sequence, const nlohmann::json&
                    {"mill_speed", limits_.mill_speed_mm_per_s},
                    {"min_coupling", limits_.min_coupling_n_per_device_mm},
                    {"max_coupling", limits_.max_coupling_n_per_device_mm}};
-  out["virtual_clock"] = virtual_clock_;
   out["server"] = server;
   return out;
 }

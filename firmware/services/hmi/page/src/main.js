@@ -12,8 +12,51 @@ let mayControl = false;
 let limits = null;
 let last = null;
 let framesSeen = 0;
+let partJob = null;  // the job whose part is shown: a new controller's job brings its own part
+let partLoading = false;
 
 function fixed(value, digits) { return value === null || value === undefined ? '–' : Number(value).toFixed(digits); }
+
+// The controller this display watches: none yet, live, or ended (with how, and its last state).
+function showController(controller) {
+  const c = $('controller');
+  if (!controller) {
+    return;
+  }
+  if (controller.ended) {
+    c.textContent = `job ended: ${controller.end || 'the controller stopped'} (last state shown)`;
+    c.className = 'state-warn';
+  } else if (controller.state === 'connected') {
+    c.textContent = `controller: ${controller.detail}`;
+    c.className = 'state-ok';
+  } else if (controller.state === 'ended') {
+    c.textContent = `controller gone: ${controller.detail} (last state shown)`;
+    c.className = 'state-warn';
+  } else {
+    c.textContent = controller.state === 'refused' ? `controller refused: ${controller.detail}`
+      : `no controller: ${controller.detail}`;
+    c.className = 'state-bad';
+  }
+  document.body.dataset.controller = controller.ended ? 'ended' : controller.state;
+  if (controller.job && controller.job !== '0' && controller.job !== partJob && !partLoading) {
+    loadPart(controller.job);
+  }
+}
+
+function loadPart(job) {
+  partLoading = true;
+  fetch('/api/part').then((r) => (r.ok ? r.json() : null)).then((part) => {
+    partLoading = false;
+    if (part === null) {
+      return;
+    }
+    scene.setPart(part);
+    partJob = part.job;
+    document.body.dataset.part = String(part.triangles);
+    document.body.dataset.job = String(part.job);
+  }).catch(() => { partLoading = false; });
+  return job;
+}
 
 function showState(message) {
   $('coverage').textContent = `${fixed(message.coverage * 100, 1)} %  (${message.touched_count} triangles)`;
@@ -46,7 +89,7 @@ function showState(message) {
   }
   const s = message.server;
   $('server').textContent = `display: ${s.clients} client(s), ${s.frames_dropped} frames dropped for slow clients, ` +
-    `${s.malformed} malformed, ${s.refused} refused`;
+    `${s.malformed} malformed, ${s.refused} refused, ${s.connections_refused} connections refused`;
 }
 
 function onMessage(message) {
@@ -59,9 +102,9 @@ function onMessage(message) {
       if (!mayControl) {
         $('param-message').textContent = message.reason;
       }
-      $('clock-note').textContent = message.virtual_clock
-        ? 'virtual clock (--fast or --speed N): the loop\'s wake-up latency and compute time are 0 by construction'
-        : '';
+      break;
+    case 'waiting':
+      showController(message.controller);
       break;
     case 'snapshot':
       limits = message.limits;
@@ -80,6 +123,10 @@ function onMessage(message) {
         scene.updateStock(message.stock);
         scene.setTouched(message.touched, false);
       }
+      showController(message.controller);
+      $('clock-note').textContent = message.virtual_clock
+        ? 'virtual clock (--fast or --speed N): the loop\'s wake-up latency and compute time are 0 by construction'
+        : '';
       scene.setTool(message.tool, message.probe, message.force);
       forcePlot.add(message.t, Math.max(message.force_peak, Math.hypot(...message.force)));
       showState(message);
@@ -124,10 +171,6 @@ for (const input of document.querySelectorAll('#params input')) {
 }
 $('reset').addEventListener('click', () => link.send({ type: 'reset' }));
 
-fetch('/api/part').then((r) => r.json()).then((part) => {
-  scene.setPart(part);
-  document.body.dataset.part = String(part.triangles);
-});
 
 // For the end-to-end test and for anyone curious: how much of the view is not background.
 window.hmiPixelStats = () => scene.pixelStats();
