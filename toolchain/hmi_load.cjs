@@ -12,7 +12,9 @@ const [url, seconds, stalledCount] = [process.argv[2], Number(process.argv[3] ||
   const stalled = [];
   for (let i = 0; i < stalledCount; i += 1) {
     const socket = net.connect({ host: hostname, port: Number(port) }, () => {
-      socket.write('GET /ws HTTP/1.1\r\nHost: x\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n' +
+      // A browser's upgrade (the display refuses one without its own Origin), then never a read.
+      socket.write(`GET /ws HTTP/1.1\r\nHost: ${hostname}:${port}\r\nOrigin: http://${hostname}:${port}\r\n` +
+        'Upgrade: websocket\r\nConnection: Upgrade\r\n' +
         'Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n');
       socket.pause();  // and never read
     });
