@@ -160,7 +160,7 @@ function hugeFrame(port) {
     const huge = hugeFrame(Number(port));
     const held = holdConnections(Number(port), 200);
     const loris = slowLoris(Number(port), 50);
-    const rates = [], coverages = [], rss = [];
+    const rates = [], coverages = [], times = [], rss = [];
     let lastFrames = await frames();
     let lastTime = Date.now();
     for (let second = 0; second < 30; second += 1) {
@@ -171,6 +171,7 @@ function hugeFrame(port) {
       lastFrames = f;
       lastTime = now;
       coverages.push(await coverage());
+      times.push(await page.evaluate(() => Number(document.body.dataset.t || 0)));
       rss.push(status(display.pid, 'VmRSS'));
     }
     const hugeResult = await huge;
@@ -188,12 +189,21 @@ function hugeFrame(port) {
       `closed after ${hugeResult.closedAfterMs} ms`);
     console.log(`200 held: ${heldCounts.opened} opened, ${heldCounts.dropped} dropped by the display; ` +
       `50 slow-loris: ${lorisCounts.opened} opened, ${lorisCounts.dropped} dropped`);
-    check(hugeResult.upgraded && hugeResult.closedAfterMs >= 0 && hugeResult.sent < 64 * 1024 * 1024,
-      'the 2 GiB frame closed its connection before its payload was read');
+    // (`sent` counts what this side queued; the display closed the socket long before reading it.)
+    check(hugeResult.upgraded && hugeResult.closedAfterMs >= 0 && hugeResult.closedAfterMs < 2000,
+      `the 2 GiB frame header closed its connection at once (${hugeResult.closedAfterMs} ms)`);
     check(slowest >= 15, `the page kept receiving frames at 15 Hz or more (slowest 2 s window ${slowest.toFixed(1)} Hz)`);
-    let rising = true;
-    for (let i = 5; i < coverages.length; i += 5) rising = rising && coverages[i] > coverages[i - 5];
-    check(rising, 'the coverage rose throughout (every 5 s)');
+    // The baked prism has 9 reachable triangles: its coverage rises in steps of 11 %, not every few
+    // seconds. The job's own time shows it going on throughout; the coverage may only rise.
+    let advancing = true, neverFell = true;
+    for (let i = 1; i < times.length; i += 1) {
+      advancing = advancing && times[i] > times[i - 1];
+      neverFell = neverFell && coverages[i] >= coverages[i - 1];
+    }
+    console.log(`simulated time: ${times.map((t) => t.toFixed(0)).join(' ')} s`);
+    check(advancing, 'the job went on throughout: its simulated time rose every second on the page');
+    check(neverFell && coverages[coverages.length - 1] > coverages[0],
+      `the coverage rose over the attack (${(100 * coverages[0]).toFixed(1)} -> ${(100 * coverages[coverages.length - 1]).toFixed(1)} %) and never fell`);
     check(Math.max(...rss) < 150 * 1024, `the display's resident memory stayed under 150 MB (max ${(Math.max(...rss) / 1024).toFixed(1)} MB)`);
     check(lorisCounts.dropped >= 50, 'the slow-loris sockets were dropped');
 

@@ -134,6 +134,7 @@ function onMessage(message) {
       framesSeen += 1;
       document.body.dataset.frames = String(framesSeen);
       document.body.dataset.coverage = String(message.coverage);
+      document.body.dataset.t = String(message.t);
       break;
     case 'accepted':
       $('param-message').textContent = `${message.name ?? message.request}: sent to the cycle`;
