@@ -597,23 +597,35 @@ case_refuses_a_bad_inject() {
 case_refuses_a_bad_display_option() {
   run_sim --fast --pattern raster --duration 1 --hmi 0.0.0.0:8080
   expect_status 2
-  expect_stderr "--hmi 0.0.0.0: listening beyond this machine needs --hmi-token T" "that a token is needed"
+  expect_stderr "--hmi 0.0.0.0: listening beyond loopback needs --hmi-token-file FILE" "that a token is needed"
   run_sim --fast --pattern raster --duration 1 --hmi 127.0.0.1
   expect_status 2
   expect_stderr "expected HOST:PORT" "the form expected"
-  run_sim --fast --pattern raster --duration 1 --hmi 0.0.0.0:8080 --hmi-token short
+  run_sim --fast --pattern raster --duration 1 --hmi-token-file token
   expect_status 2
-  expect_stderr "--hmi-token: at least 8 characters" "the token's rule"
-  run_sim --fast --pattern raster --duration 1 --hmi-token s3cret-token
+  expect_stderr "--hmi-token-file and --hmi-assets go with --hmi" "the option it needs"
+  run_sim --fast --pattern raster --duration 1 --hmi 127.0.0.1:0 --display-socket "$PWD/display.sock"
   expect_status 2
-  expect_stderr "--hmi-token and --hmi-assets go with --hmi" "the option it needs"
+  expect_stderr "--hmi makes a socket of its own" "that the two do not go together"
+  # A token others may read is refused by the display, and the job does not start.
+  echo "s3cret-token" >token
+  chmod 644 token
+  run_sim --fast --pattern raster --duration 1 --no-journal --hmi 127.0.0.1:0 --hmi-token-file "$PWD/token"
+  expect_status 2
+  expect_stderr "mode 0644 lets others read it; chmod 600" "why the token file is refused"
+  expect_stderr "stencil-display did not start" "that the display did not start"
+  chmod 600 token
+  echo "short" >token
+  run_sim --fast --pattern raster --duration 1 --no-journal --hmi 127.0.0.1:0 --hmi-token-file "$PWD/token"
+  expect_status 2
+  expect_stderr "the token: at least 8 characters" "the token's rule"
   run_sim --fast --pattern raster --duration 1 --no-journal --hmi 127.0.0.1:0 --hmi-assets "$PWD/no-page"
   expect_status 2
   expect_stderr "the display's page is not built: no .*no-page/index.html" "that the page is missing"
   : >part.stbl
   run_rig --tables part.stbl --serial /dev/ttyS0 --haptic pio:/dev/uio0 --hmi 0.0.0.0:8080
   expect_status 2
-  expect_stderr "listening beyond this machine needs --hmi-token" "that a token is needed (the rig, before it opens anything)"
+  expect_stderr "listening beyond loopback needs --hmi-token-file" "that a token is needed (the rig, before it opens anything)"
 }
 
 case_refuses_a_bad_operator_csv() {
