@@ -34,7 +34,7 @@ void OperatorTerminal::on_telemetry(const control::Telemetry& frame) {
 
 void OperatorTerminal::forward_requests(control::CommandRing& commands) {
   if (job_.reset_requested && job_.reset_requested()) {
-    static_cast<void>(commands.push({control::CommandKind::Reset}));
+    static_cast<void>(commands.push({control::CommandKind::Reset, 0.0, control::CommandSource::Terminal}));
   }
 }
 

@@ -67,6 +67,7 @@ void fill_result(RigResult& result, const runtime::Job& assembled, const runtime
   result.safe_state_entries = controller.counters().safe_state_entries;
   result.resets_accepted = controller.counters().resets_accepted;
   result.resets_refused = controller.counters().resets_refused;
+  result.operator_record = runtime::operator_record_of(assembled, outcome);
 }
 
 }  // namespace

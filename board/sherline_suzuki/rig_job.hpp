@@ -98,6 +98,7 @@ struct RigResult {
   std::string journal_error;
   journal::JobHistory earlier;        // the job before this run (earlier.segments 0: a fresh job)
   std::uint32_t touched_rebuilt = 0;  // the touched set rebuilt from it (earlier.touched_recorded: as recorded)
+  report::OperatorRecord operator_record;  // what the operator did, where everything ended
 };
 
 // Homes the machine (a resumed job: after rebuilding what the journal says was touched and cut), then

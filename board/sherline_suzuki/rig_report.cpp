@@ -22,6 +22,7 @@ bool write_rig_report(const std::string& path, const RigResult& r, const std::st
   f.model_removed_volume_mm3 = r.model_removed_mm3;
   f.safe_state = r.safe_state;
   f.earlier = r.earlier;
+  f.operator_record = r.operator_record;
   f.touched_rebuilt = r.touched_rebuilt;
   const nlohmann::json rig_sections = {
       {"first_fault", r.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)

@@ -11,11 +11,20 @@ bool JournalReplay::before_cycle(const runtime::CycleTime& /*time*/) {
   }
   recorded_ = &records_[cycles_];
   device_.set(*recorded_);
-  // A safe state the device's read does not explain (the machine's fault, a stalled host, a stop):
-  // the record says it came, so it comes here too, at the same cycle.
-  if (recorded_->safe_reason != control::SafeReason::None && controller_.safe_reason() == control::SafeReason::None &&
-      !control::is_device_reason(recorded_->safe_reason)) {
-    static_cast<void>(commands_.push({control::CommandKind::Stop}));
+  // The commands this cycle took, as they came (a command taken before the first record: at once).
+  bool stopped = false;
+  for (; next_taken_ < taken_.size() && taken_[next_taken_].cycle <= recorded_->cycle; ++next_taken_) {
+    const control::CommandEvent& event = taken_[next_taken_];
+    stopped = stopped || event.kind == control::CommandKind::Stop || event.kind == control::CommandKind::JournalFailed;
+    if (!commands_.push({event.kind, event.asked, event.source})) {
+      ++commands_not_replayed_;
+    }
+  }
+  // A safe state the device's read and the commands do not explain (the machine's fault, a stalled
+  // host, a journal without command records): the record says it came, so it comes here too.
+  if (!stopped && recorded_->safe_reason != control::SafeReason::None &&
+      controller_.safe_reason() == control::SafeReason::None && !control::is_device_reason(recorded_->safe_reason)) {
+    static_cast<void>(commands_.push({control::CommandKind::Stop, 0.0, control::CommandSource::Replay}));
   }
   return true;
 }

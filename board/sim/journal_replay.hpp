@@ -1,6 +1,7 @@
 // JournalReplay: one recorded run of a journal replayed (stencil-sim --replay): before each cycle the
-// device gives exactly what the recorded cycle read, and after it the virtual tool is compared with
-// the recorded one, bit for bit. The run ends with the records. A hook of the job's run, virtual
+// device gives exactly what the recorded cycle read and the cycle's command ring holds the commands
+// the recorded cycle took (a stop, a reset, a pause, a parameter), and after it the virtual tool is
+// compared with the recorded one, bit for bit. The run ends with the records. A hook of the job's run, virtual
 // time only.
 #pragma once
 
@@ -18,9 +19,10 @@ class JournalReplay final : public runtime::JobHooks {
  public:
   // Everything must outlive the replay; `device` is what the cycle reads, `commands` its command
   // ring (this hook pushes on the cycle's thread, which in virtual time is the ring's one producer).
-  JournalReplay(const std::vector<control::JournalRecord>& records, stencil::sim::ReplayHapticDevice& device,
-                const control::Controller& controller, control::CommandRing& commands)
-      : records_(records), device_(device), controller_(controller), commands_(commands) {}
+  JournalReplay(const std::vector<control::JournalRecord>& records, const std::vector<control::CommandEvent>& taken,
+                stencil::sim::ReplayHapticDevice& device, const control::Controller& controller,
+                control::CommandRing& commands)
+      : records_(records), taken_(taken), device_(device), controller_(controller), commands_(commands) {}
 
   bool before_cycle(const runtime::CycleTime& time) override;
   void after_cycle(const runtime::CycleTime& time, control::CycleStatus status) override;
@@ -31,9 +33,13 @@ class JournalReplay final : public runtime::JobHooks {
   [[nodiscard]] std::uint64_t mismatches() const { return mismatches_; }
   [[nodiscard]] std::int64_t first_mismatch() const { return first_mismatch_; }
   [[nodiscard]] control::SafeReason recorded_reason() const { return recorded_reason_; }
+  // Recorded commands that could not be given back (more in one cycle than the ring holds).
+  [[nodiscard]] std::uint64_t commands_not_replayed() const { return commands_not_replayed_; }
 
  private:
   const std::vector<control::JournalRecord>& records_;
+  const std::vector<control::CommandEvent>& taken_;  // in order: the cycles that took them rise
+  std::size_t next_taken_ = 0;
   stencil::sim::ReplayHapticDevice& device_;
   const control::Controller& controller_;
   control::CommandRing& commands_;
@@ -42,6 +48,7 @@ class JournalReplay final : public runtime::JobHooks {
   std::uint64_t mismatches_ = 0;
   std::int64_t first_mismatch_ = -1;
   control::SafeReason recorded_reason_ = control::SafeReason::None;
+  std::uint64_t commands_not_replayed_ = 0;
 };
 
 }  // namespace stencil::board::sim

@@ -105,7 +105,9 @@ SimResult run_virtual(const SimJob& job, runtime::Job& assembled, MillWiring& mi
   FaultInjector fault(job.fault, hand.wiring(), mill.fake(), assembled.controller(), kPeriodNs);
   std::optional<JournalReplay> replay;
   if (job.replay != nullptr) {
-    replay.emplace(*job.replay, replay_device, assembled.controller(), assembled.rings().commands);
+    static const std::vector<control::CommandEvent> kNone;
+    replay.emplace(*job.replay, job.replay_commands != nullptr ? *job.replay_commands : kNone, replay_device,
+                   assembled.controller(), assembled.rings().commands);
   }
   JobEnd end(job, assembled.controller());
   runtime::JobHooks* const device_side = replay ? static_cast<runtime::JobHooks*>(&*replay) : &hand;
@@ -123,6 +125,7 @@ SimResult run_virtual(const SimJob& job, runtime::Job& assembled, MillWiring& mi
     result.replay_mismatches = replay->mismatches();
     result.replay_first_mismatch = replay->first_mismatch();
     result.replay_recorded_reason = replay->recorded_reason();
+    result.replay_commands_not_given = replay->commands_not_replayed();
   }
   fill_result(result, assembled, outcome, mill, false, wall_start);
   return result;

@@ -61,6 +61,7 @@ struct SimJob {
   // operator and the device; each cycle reads exactly what the recorded one read. With resume_from
   // set to the runs before it, a resumed run is replayed from where it started.
   const std::vector<control::JournalRecord>* replay = nullptr;
+  const std::vector<control::CommandEvent>* replay_commands = nullptr;  // the commands that run took (null: none)
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.
   double pace = 0.0;
@@ -126,7 +127,9 @@ struct SimResult {
   std::uint64_t replay_mismatches = 0;
   std::int64_t replay_first_mismatch = -1;
   control::SafeReason replay_recorded_reason = control::SafeReason::None;
+  std::uint64_t replay_commands_not_given = 0;
   std::uint32_t touched_rebuilt = 0;
+  report::OperatorRecord operator_record;  // what the operator did, where everything ended
   // Memory: resident once the job was set up (the journal rebuilt, the machine homed), at its end,
   // and the most it ever was (kB).
   std::int64_t rss_after_setup_kb = 0;

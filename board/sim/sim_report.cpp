@@ -30,6 +30,7 @@ report::JobFigures figures_of(const SimResult& r) {
   f.model_removed_volume_mm3 = r.model_removed_volume_mm3;
   f.safe_state = r.safe_state;
   f.earlier = r.earlier;
+  f.operator_record = r.operator_record;
   f.touched_rebuilt = r.touched_rebuilt;
   return f;
 }

@@ -32,6 +32,7 @@ void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::
   result.wakeup_latency_us = realtime ? report::quantiles_of(controller.statistics().wakeup_latency) : Quantiles{0.0, 0.0, 0.0, 0.0};
   result.compute_us = report::quantiles_of(outcome.compute);
   result.simulated_s = outcome.run_s;
+  result.operator_record = runtime::operator_record_of(job, outcome);
   result.coverage_fraction = reachable_coverage(*job.parts().part, controller.touched());
   // Over the whole job: a resumed one's journal says what the runs before this one reached.
   result.max_force_n = std::max(controller.max_force_n(), result.earlier.max_force_n);

@@ -116,6 +116,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
   const app::CpuLatencyHold latency_hold;
   for (std::uint32_t run = 0; run < history.segments; ++run) {
     std::vector<control::JournalRecord> records;
+    std::vector<control::CommandEvent> commands;
     std::uint32_t in_run = 0;
     journal::JournalVisitor keep;
     keep.resume = [&](const journal::JournalResume&) { ++in_run; };
@@ -124,11 +125,17 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
         records.push_back(r);
       }
     };
+    keep.command = [&](const control::CommandEvent& e) {
+      if (in_run == run) {
+        commands.push_back(e);
+      }
+    };
     const journal::JournalReadResult read = journal::read_journal_file(path, keep, history.good_bytes);
     if (!read.ok) {
       return bad_input("--replay: " + read.error);
     }
     job.replay = &records;
+    job.replay_commands = &commands;
     job.resume_from = run == 0 ? "" : path;
     job.resume_bytes = run == 0 ? 0 : history.run_starts[run - 1];
     result = board::sim::run_fast(job);
@@ -138,11 +145,12 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
     }
     const bool reason_same = !control::is_device_reason(result.replay_recorded_reason) ||
                              result.safe_state == result.replay_recorded_reason;
-    const bool same = result.replay_mismatches == 0 && result.replay_cycles == records.size() && reason_same;
+    const bool same = result.replay_mismatches == 0 && result.replay_cycles == records.size() && reason_same &&
+                      result.replay_commands_not_given == 0;
     all_same = all_same && same;
-    std::printf("replay run %u: %llu of %zu recorded cycles, %llu with a different virtual tool%s; recorded ending %s, "
-                "replayed %s: %s\n",
-                run, static_cast<unsigned long long>(result.replay_cycles), records.size(),
+    std::printf("replay run %u: %llu of %zu recorded cycles, %zu recorded commands, %llu cycles with a different virtual "
+                "tool%s; recorded ending %s, replayed %s: %s\n",
+                run, static_cast<unsigned long long>(result.replay_cycles), records.size(), commands.size(),
                 static_cast<unsigned long long>(result.replay_mismatches),
                 result.replay_first_mismatch >= 0 ? (" (the first at cycle " + std::to_string(result.replay_first_mismatch) + ")").c_str() : "",
                 control::safe_reason_name(result.replay_recorded_reason), control::safe_reason_name(result.safe_state),

@@ -7,8 +7,9 @@ Job::Job(const JobParts& parts, Timing timing)
     : parts_(parts), rings_(std::make_unique<control::CycleRingStorage>()), records_(parts.journal, rings_->commands) {
   const tables::PartTables& part = *parts_.part;
   records_.show_on(parts_.display);
+  records_.take_commands_from(&rings_->command_events);
   // The controller is large (the touched set): on the heap, as the machine side.
-  controller_ = std::make_unique<control::Controller>(part, *parts_.device, rings_->rings(), parts_.controller);
+  controller_ = std::make_unique<control::Controller>(part, *parts_.device, rings_->rings(parts_.display != nullptr ? &parts_.display->commands() : nullptr), parts_.controller);
   if (!controller_->ready()) {
     error_ = "the tables' tool could not be grown for the touched set";
     return;
@@ -99,6 +100,37 @@ std::string Job::describe(StartFailure failure) const {
       return "the machine did not start (spindle on)";
   }
   return "";
+}
+
+report::OperatorRecord operator_record_of(const Job& job, const RunOutcome& outcome) {
+  report::OperatorRecord r;
+  const control::ControllerConfig& config = job.parts().controller;
+  r.commands = job.records().commands();
+  r.commands_unlisted = job.records().commands_unlisted();
+  r.initial_limits = {config.haptic.coupling_n_per_device_mm, config.haptic.max_force_n,
+                      config.max_axis_move_mm / config.period_s};
+  r.start_ns = outcome.start_ns;
+  r.period_s = config.period_s;
+  r.machine_holds = job.machine().statistics().holds;
+  r.machine_held_updates = job.machine().statistics().held_updates;
+  r.safe_source = job.controller().safe_source();
+  // The newest record is what a display showed last: the same figures here.
+  control::JournalRecord last{};
+  const bool have = job.records().last_record(last);
+  const Eigen::Vector3d device = have ? Eigen::Vector3d(last.device_mm[0], last.device_mm[1], last.device_mm[2])
+                                      : Eigen::Vector3d::Zero();
+  const Eigen::Vector3d tip = job.controller().virtual_tip_mm();
+  const Eigen::Vector3d tip_machine = motion::world_to_machine_mm(config.frames, tip);
+  const Eigen::Vector3d mill = job.machine().commanded_tip_mm();
+  const Eigen::Vector3d mill_machine = motion::world_to_machine_mm(config.frames, mill);
+  for (int i = 0; i < 3; ++i) {
+    r.positions.device_mm[i] = device[i];
+    r.positions.virtual_work_mm[i] = tip[i];
+    r.positions.virtual_machine_mm[i] = tip_machine[i];
+    r.positions.mill_work_mm[i] = mill[i];
+    r.positions.mill_machine_mm[i] = mill_machine[i];
+  }
+  return r;
 }
 
 }  // namespace stencil::runtime

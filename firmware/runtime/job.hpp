@@ -18,10 +18,18 @@
 #include "firmware/core/control/machine_record.hpp"
 #include "firmware/core/control/machine_side.hpp"
 #include "firmware/runtime/job_parts.hpp"
+#include "firmware/runtime/run_outcome.hpp"
+#include "firmware/services/report/job_report.hpp"
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/services/journal/journal_drain.hpp"
 
 namespace stencil::runtime {
+
+// The machine side as a display shows it (the machine thread, after an update).
+[[nodiscard]] inline control::MachineView view_of(const control::MachineSide& machine) {
+  const Eigen::Vector3d& tip = machine.commanded_tip_mm();
+  return {machine.statistics().last_lag_mm, {tip.x(), tip.y(), tip.z()}, machine.held()};
+}
 
 // How the machine is started once the job is assembled.
 struct MachineStart {
@@ -72,7 +80,7 @@ class Job {
   [[nodiscard]] const control::CommandedStock& model() const { return *model_; }
   [[nodiscard]] control::CycleRingStorage& rings() { return *rings_; }
   [[nodiscard]] journal::JournalDrain& records() { return records_; }
-  [[nodiscard]] control::DisplayCommands& display_commands() { return display_commands_; }
+  [[nodiscard]] const journal::JournalDrain& records() const { return records_; }
   [[nodiscard]] hal::Clock& machine_clock() const { return *parts_.machine_clock; }
   // A resumed job: the job before this run (earlier.segments 0: a fresh job), and the touched set's
   // size rebuilt from the virtual tool it recorded.
@@ -86,7 +94,6 @@ class Job {
   JobParts parts_;
   std::unique_ptr<control::CycleRingStorage> rings_;
   journal::JournalDrain records_;
-  control::DisplayCommands display_commands_;
   std::unique_ptr<control::Controller> controller_;
   std::unique_ptr<control::MachineSide> machine_;
   std::vector<float> model_cells_;  // allocated here, once
@@ -97,5 +104,8 @@ class Job {
   std::uint32_t touched_rebuilt_ = 0;
   std::string error_;
 };
+
+// What the operator did in the run and where everything ended, for the job's report (after the run).
+[[nodiscard]] report::OperatorRecord operator_record_of(const Job& job, const RunOutcome& outcome);
 
 }  // namespace stencil::runtime

@@ -34,7 +34,7 @@ class JobThreads {
         hook->after_machine_update();
       }
       if (parts.display != nullptr && job_.model().ready()) {
-        parts.display->on_machine(machine.statistics().last_lag_mm, job_.model());
+        parts.display->on_machine(view_of(machine), job_.model());
       }
       caught_up_.store(machine.path_left() <= 1 && machine.at_goal());
       next = std::max(next + parts.update_ns, clock.now_ns());
@@ -63,7 +63,6 @@ class JobThreads {
       }
       // After the stop, nothing more: it is the last command the cycle takes.
       if (!stop_sent) {
-        job_.display_commands().forward(display, rings.commands);
         for (JobHooks* hook : hooks_) {
           hook->forward_requests(rings.commands);
         }
@@ -129,7 +128,9 @@ class JobThreads {
       return false;
     }
     stop_asked_.store(true, std::memory_order_release);
-    return job_.rings().commands.push({control::CommandKind::Stop});
+    const bool by_signal = interrupted != nullptr && interrupted->load();
+    return job_.rings().commands.push(
+        {control::CommandKind::Stop, 0.0, by_signal ? control::CommandSource::Signal : control::CommandSource::Program});
   }
 
   Job& job_;
@@ -157,7 +158,13 @@ RunOutcome run_on_threads(Job& job, const PeriodicRunner& runner, std::span<JobH
   threads.stop.store(true);
   machine_thread.join();
   records_thread.join();
-  job.records().drain(job.rings().journal);  // the last records, left after the records thread's last look
+  job.records().drain(job.rings().journal, true);  // the last records, left after the records thread's last look
+  // And the last telemetry, so a display ends on the cycle's last state.
+  for (control::Telemetry frame{}; job.rings().telemetry.pop(frame);) {
+    if (job.parts().display != nullptr) {
+      job.parts().display->on_telemetry(frame);
+    }
+  }
   // Also when the runner refused before the cycle ran (or the cycle never reached the machine side):
   // the machine is stopped here all the same, while its far end still answers.
   job.machine().shut_down(job.machine_clock().now_ns() + job.parts().shut_down_bound_ns);

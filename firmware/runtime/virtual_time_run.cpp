@@ -30,7 +30,7 @@ class VirtualTimeLoop {
         break;
       }
     }
-    job_.records().drain(job_.rings().journal);
+    job_.records().drain(job_.rings().journal, true);
     job_.machine().shut_down(clock.now_ns() + job_.parts().shut_down_bound_ns);
     outcome_.start_ns = start_ns_;
     outcome_.run_s = seconds(cycle_ns_);
@@ -51,7 +51,7 @@ class VirtualTimeLoop {
     }
     control::DisplayFeed* display = job_.parts().display;
     if (display != nullptr && job_.model().ready()) {
-      display->on_machine(machine.statistics().last_lag_mm, job_.model());
+      display->on_machine(view_of(machine), job_.model());
     }
     if (machine.state() == control::MachineSideState::Stopped && outcome_.machine_stopped_s < 0.0) {
       outcome_.machine_stopped_s = seconds(cycle_ns_);
@@ -127,7 +127,6 @@ class VirtualTimeLoop {
       }
     }
     if (job_.controller().statistics().cycles % 20 == 0) {
-      job_.display_commands().forward(display, rings.commands);
       for (JobHooks* hook : hooks_) {
         hook->forward_requests(rings.commands);
       }
@@ -147,7 +146,8 @@ class VirtualTimeLoop {
     job_.records().sync_if_due();
     const std::atomic<bool>* interrupted = job_.parts().interrupted;
     if (interrupted != nullptr && interrupted->load()) {
-      static_cast<void>(job_.rings().commands.push({control::CommandKind::Stop}));  // taken by the next cycle
+      static_cast<void>(job_.rings().commands.push(
+          {control::CommandKind::Stop, 0.0, control::CommandSource::Signal}));  // taken by the next cycle
     }
     const bool caught_up = job_.machine().path_left() <= 1 && job_.machine().at_goal();
     return std::any_of(hooks_.begin(), hooks_.end(), [&](JobHooks* hook) { return hook->job_done(t_s, caught_up); });

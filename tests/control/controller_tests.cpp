@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <memory>
+#include <vector>
 
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/tables/table_loader.hpp"
@@ -47,6 +48,11 @@ struct Bench {
   MachineHandoffRing machine;
   TelemetryRing telemetry;
   JournalRing journal;
+  CommandEventRing command_events;
+  CommandRing display_commands;
+  std::vector<CommandEvent> events;  // every command the cycle took, in order
+  std::vector<JournalRecord> records;
+  bool keep_records = false;
   std::unique_ptr<Controller> controller;
   hal::MonotonicNs now = 1'000'000'000;
   MachineHandoff last_handoff{};
@@ -57,7 +63,7 @@ struct Bench {
 
   explicit Bench(const ControllerConfig& c = config()) {
     device.hold_at(kHomeDevice.x(), kHomeDevice.y(), kHomeDevice.z());
-    controller = std::make_unique<Controller>(prism.part, device, CycleRings{commands, machine_events, machine, telemetry, journal}, c);
+    controller = std::make_unique<Controller>(prism.part, device, CycleRings{commands, machine_events, machine, telemetry, journal, command_events, &display_commands}, c);
     CHECK(controller->ready());
   }
 
@@ -71,6 +77,13 @@ struct Bench {
     }
     JournalRecord record{};
     while (drain_journal && journal.pop(record)) {
+      if (keep_records) {
+        records.push_back(record);
+      }
+    }
+    CommandEvent event{};
+    while (command_events.pop(event)) {
+      events.push_back(event);
     }
     Telemetry t{};
     while (telemetry.pop(t)) {
@@ -314,6 +327,117 @@ TEST(Controller, AStopCommandEntersTheSafeState) {
   CHECK(bench.commands.push({CommandKind::Stop}));
   CHECK(bench.cycle() == CycleStatus::SafeState);
   check_safe(bench, SafeReason::Stopped);
+}
+
+TEST(Controller, AStopFromTheDisplayIsTakenByTheNextCycleAndRecordedWithItsSource) {
+  Bench bench;
+  bench.keep_records = true;
+  bench.cycles(20);
+  CHECK(bench.display_commands.push({CommandKind::Stop, 0.0, CommandSource::Display}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::Stopped);
+  CHECK(bench.controller->safe_source() == CommandSource::Display);
+  LONGS_EQUAL(1, bench.events.size());
+  const CommandEvent& stop = bench.events[0];
+  CHECK(stop.kind == CommandKind::Stop);
+  CHECK(stop.source == CommandSource::Display);
+  CHECK(stop.outcome == CommandOutcome::Done);
+  LONGS_EQUAL(21, stop.cycle);
+  LONGS_EQUAL(20, stop.queued_after_cycle);  // queued between cycles 20 and 21: one cycle's wait
+  const JournalRecord& record = bench.records.back();
+  CHECK(record.safe_reason == SafeReason::Stopped);
+  CHECK(record.safe_source == CommandSource::Display);
+  LONGS_EQUAL(21, record.cycle);
+  // A second stop finds the safe state latched, and says so.
+  CHECK(bench.commands.push({CommandKind::Stop, 0.0, CommandSource::Signal}));
+  bench.cycles(1);
+  CHECK(bench.events.back().outcome == CommandOutcome::AlreadySafe);
+  CHECK(bench.controller->safe_source() == CommandSource::Display);
+}
+
+TEST(Controller, APauseHoldsTheVirtualToolAndTheMillAndAResumeCarriesOnWithoutAReset) {
+  Bench bench;
+  bench.keep_records = true;
+  bench.cycles(20);
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(20.0, 0.0, 0.0), 100.0);
+  CHECK(bench.display_commands.push({CommandKind::Pause, 0.0, CommandSource::Display}));
+  bench.cycles(1);
+  CHECK(bench.controller->paused());
+  CHECK(bench.last_handoff.paused);
+  CHECK(bench.last_telemetry.paused);
+  const Eigen::Vector3d held = bench.controller->virtual_tip_mm();
+  // The hand moves on; the tool stays, and the hand feels it pulled back towards it.
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(30.0, 0.0, 0.0), 100.0);
+  CHECK(bench.controller->virtual_tip_mm() == held);
+  CHECK(bench.force_written() > 0.5);
+  CHECK(bench.device.last_command().force_n[0] < 0.0);
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  CHECK(bench.records.back().paused);
+  // A second pause says so; a resume carries on with no reset and no safe state.
+  CHECK(bench.display_commands.push({CommandKind::Pause, 0.0, CommandSource::Display}));
+  bench.cycles(1);
+  CHECK(bench.events.back().outcome == CommandOutcome::AlreadyPaused);
+  CHECK(bench.display_commands.push({CommandKind::Resume, 0.0, CommandSource::Display}));
+  bench.cycles(100);
+  CHECK_FALSE(bench.controller->paused());
+  CHECK_FALSE(bench.last_handoff.paused);
+  CHECK(bench.controller->virtual_tip_mm().x() > held.x());
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+  LONGS_EQUAL(0, bench.controller->counters().resets_accepted);
+  CHECK(bench.events.back().kind == CommandKind::Resume);
+  CHECK(bench.events.back().outcome == CommandOutcome::Done);
+  CHECK(bench.display_commands.push({CommandKind::Resume, 0.0, CommandSource::Display}));
+  bench.cycles(1);
+  CHECK(bench.events.back().outcome == CommandOutcome::NotPaused);
+}
+
+TEST(Controller, AStopEndsAPauseAndAPauseInTheSafeStateIsRefused) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.commands.push({CommandKind::Pause, 0.0, CommandSource::Terminal}));
+  bench.cycles(1);
+  CHECK(bench.controller->paused());
+  CHECK(bench.commands.push({CommandKind::Stop, 0.0, CommandSource::Terminal}));
+  bench.cycles(1);
+  CHECK_FALSE(bench.controller->paused());
+  CHECK(bench.last_handoff.safe_state);
+  CHECK(bench.commands.push({CommandKind::Pause, 0.0, CommandSource::Terminal}));
+  bench.cycles(1);
+  CHECK(bench.events.back().outcome == CommandOutcome::NotRunning);
+  CHECK_FALSE(bench.controller->paused());
+}
+
+TEST(Controller, EachParameterChangeIsAnEventWithTheValueAskedAndTheValueApplied) {
+  Bench bench;
+  bench.cycles(5);
+  CHECK(bench.display_commands.push({CommandKind::SetForceLimit, 50.0, CommandSource::Display}));
+  CHECK(bench.display_commands.push({CommandKind::SetSpeedLimit, 20.0, CommandSource::Display}));
+  CHECK(bench.display_commands.push({CommandKind::SetCoupling, -1.0, CommandSource::Display}));
+  bench.cycles(1);
+  LONGS_EQUAL(3, bench.events.size());
+  CHECK(bench.events[0].outcome == CommandOutcome::Clamped);
+  DOUBLES_EQUAL(50.0, bench.events[0].asked, 0.0);
+  DOUBLES_EQUAL(config().haptic.max_force_n, bench.events[0].applied, 0.0);  // the board's limit
+  CHECK(bench.events[1].outcome == CommandOutcome::Done);
+  DOUBLES_EQUAL(20.0, bench.events[1].applied, 1e-9);
+  DOUBLES_EQUAL(bench.last_telemetry.speed_limit_mm_per_s, bench.events[1].applied, 0.0);
+  CHECK(bench.events[2].outcome == CommandOutcome::Refused);
+  DOUBLES_EQUAL(config().haptic.coupling_n_per_device_mm, bench.events[2].applied, 0.0);  // unchanged
+  for (const CommandEvent& e : bench.events) {
+    LONGS_EQUAL(6, e.cycle);
+    CHECK(e.source == CommandSource::Display);
+  }
+}
+
+TEST(Controller, ACommandTheEventRingCannotTakeIsAJournalFault) {
+  Bench bench;
+  bench.cycles(5);
+  for (std::size_t i = 0; i < CommandEventRing::capacity(); ++i) {
+    CHECK(bench.command_events.push({}));  // nobody drains it
+  }
+  CHECK(bench.commands.push({CommandKind::SetForceLimit, 3.0, CommandSource::Display}));
+  CHECK(bench.controller->step(bench.now, bench.now) == CycleStatus::SafeState);
+  CHECK(bench.controller->safe_reason() == SafeReason::JournalFull);
 }
 
 TEST(Controller, TheDevicesOwnFaultFlagEntersTheSafeState) {

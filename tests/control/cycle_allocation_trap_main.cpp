@@ -1,6 +1,7 @@
 // Runs the whole cycle (Controller::step and finish: commands, the device read and its checks, the
 // engine, the force write, the machine handoff, the journal and telemetry rings, the safe state and
-// a reset) with every heap entry point wrapped at link time, and fails if any is reached while armed.
+// a reset, a pause and a resume and a parameter change, the display's command ring and the ring of
+// the commands taken) with every heap entry point wrapped at link time, and fails if any is reached while armed.
 // A plain program rather than a CppUTest suite: CppUTest's own operator new would clash.
 #include <cmath>
 #include <cstdio>
@@ -26,6 +27,8 @@ int main() {
   static control::MachineHandoffRing handoffs;
   static control::TelemetryRing telemetry;
   static control::JournalRing journal;
+  static control::CommandEventRing taken;
+  static control::CommandRing display_commands;
   static sim::DirectHapticDevice device{stencil::board::sherline_suzuki::kDeviceRange};
   control::ControllerConfig config;
   config.frames = {10.0, Eigen::Vector3d::Zero(), Eigen::Vector3d(25.0, 12.5, 20.0), {-1, -1, 1}, 640.0};
@@ -33,7 +36,7 @@ int main() {
   config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
   config.home_tip_mm = Eigen::Vector3d(25.0, 12.5, 20.0);
   auto controller = std::make_unique<control::Controller>(
-      part, device, control::CycleRings{commands, machine_events, handoffs, telemetry, journal}, config);
+      part, device, control::CycleRings{commands, machine_events, handoffs, telemetry, journal, taken, &display_commands}, config);
   if (!controller->ready()) {
     return 1;
   }
@@ -45,8 +48,16 @@ int main() {
   unsigned long cycles = 0;
   Eigen::Vector3d held = Eigen::Vector3d::Zero();
   stencil::test::arm_heap_trap("cycle_allocation_trap");
+  unsigned long commands_taken = 0;
   for (int i = 0; i < kCycles; ++i) {
     const double angle = 2e-3 * i;
+    if (i == kCycles / 8) {
+      static_cast<void>(display_commands.push({control::CommandKind::Pause, 0.0, control::CommandSource::Display}));
+    }
+    if (i == kCycles / 8 + 200) {
+      static_cast<void>(display_commands.push({control::CommandKind::Resume, 0.0, control::CommandSource::Display}));
+      static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimit, 20.0, control::CommandSource::Display}));
+    }
     if (i == kCycles / 2) {
       static_cast<void>(commands.push({control::CommandKind::Stop}));
       held = 10.0 * controller->virtual_tip_mm();
@@ -70,18 +81,23 @@ int main() {
     control::Telemetry frame{};
     while (telemetry.pop(frame)) {
     }
+    control::CommandEvent event{};
+    while (taken.pop(event)) {
+      commands_taken += event.outcome == control::CommandOutcome::Done ? 1 : 0;
+    }
     now += 1'000'000;
     ++cycles;
   }
   stencil::test::disarm_heap_trap();
   const unsigned long trapped = stencil::test::trapped_heap_calls();
   std::printf("cycle_allocation_trap: %lu cycles, %lu heap calls inside them, %zu triangles touched, %llu safe-state "
-              "entries, %llu resets accepted\n",
+              "entries, %llu resets accepted, %lu commands done\n",
               cycles, trapped, controller->touched().count(),
               static_cast<unsigned long long>(controller->counters().safe_state_entries),
-              static_cast<unsigned long long>(controller->counters().resets_accepted));
+              static_cast<unsigned long long>(controller->counters().resets_accepted), commands_taken);
+  // Pause, resume, the speed, the stop and the reset: each done.
   const bool exercised = controller->touched().count() > 0 && controller->counters().safe_state_entries == 1 &&
-                         controller->counters().resets_accepted == 1;
+                         controller->counters().resets_accepted == 1 && commands_taken == 5;
   std::printf("%lu passed, %lu failed\n", trapped == 0 && exercised ? 1ul : 0ul, trapped == 0 && exercised ? 0ul : 1ul);
   return trapped == 0 && exercised ? 0 : 1;
 }

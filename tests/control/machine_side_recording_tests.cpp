@@ -69,7 +69,7 @@ struct Bench {
   void update() {
     for (int i = 0; i < 33; ++i) {
       x_mm += 1e-3;
-      CHECK(handoffs.push({++cycle, {x_mm, 12.5, 20.0}, false}));
+      CHECK(handoffs.push({++cycle, {x_mm, 12.5, 20.0}, false, false}));
     }
     now += kUpdateNs;
     machine->update(now + 2 * kUpdateNs);

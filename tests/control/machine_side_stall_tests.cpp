@@ -41,7 +41,7 @@ struct Bench {
   // One update's cycles handing over `tip`, then the update; the backlog it reports (-1: none).
   int update(const Eigen::Vector3d& tip) {
     for (int i = 0; i < 33; ++i) {
-      CHECK(handoffs.push({++cycle, {tip.x(), tip.y(), tip.z()}, false}));
+      CHECK(handoffs.push({++cycle, {tip.x(), tip.y(), tip.z()}, false, false}));
     }
     now += kUpdateNs;
     machine->update(now + 2 * kUpdateNs);

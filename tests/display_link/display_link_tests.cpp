@@ -156,9 +156,9 @@ TEST(DisplayLink, RequestsAreDecidedOnTheControllersSideAndAcceptedOnesReachTheC
   CHECK(static_cast<MessageKind>(answers[1].kind) == MessageKind::Refused);
   STRCMP_CONTAINS("outside the coupling's range", reason_of(answers[1]).c_str());
   control::Command command{};
-  CHECK(link.pop_command(command));
+  CHECK(link.commands().pop(command));
   CHECK(command.kind == control::CommandKind::Reset);
-  CHECK_FALSE(link.pop_command(command));
+  CHECK_FALSE(link.commands().pop(command));
 }
 
 TEST(DisplayLink, WhenTheControllerEndsTheDisplayKeepsItsLastStateAndSaysHow) {

@@ -90,7 +90,8 @@ TEST_GROUP(RequestServer) {
 TEST(RequestServer, AWelcomedDisplaysAcceptedRequestsReachTheQueueAndRefusalsComeBackWithTheReason) {
   Folder folder;
   const int feed = memfd_create("feed", MFD_CLOEXEC);
-  RequestServer server({folder.socket()}, feed, limits_refusal);
+  control::CommandRing server_ring;
+  RequestServer server({folder.socket()}, feed, limits_refusal, server_ring);
   std::string error;
   CHECK_TRUE_TEXT(server.start(error), error.c_str());
   struct stat st {};
@@ -114,10 +115,11 @@ TEST(RequestServer, AWelcomedDisplaysAcceptedRequestsReachTheQueueAndRefusalsCom
   CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Refused);
   STRCMP_CONTAINS("above the board's force limit", reason_of(answer).c_str());
   control::Command command{};
-  CHECK(server.pop_command(command));
+  CHECK(server_ring.pop(command));  // straight into the cycle's ring for the displays
   CHECK(command.kind == control::CommandKind::SetCoupling);
+  CHECK(command.source == control::CommandSource::Display);
   DOUBLES_EQUAL(0.8, command.value, 0.0);
-  CHECK_FALSE(server.pop_command(command));
+  CHECK_FALSE(server_ring.pop(command));
   const RequestCounters counters = server.counters();
   CHECK_EQUAL(1U, counters.accepted);
   CHECK_EQUAL(1U, counters.refused);
@@ -130,7 +132,8 @@ TEST(RequestServer, AWelcomedDisplaysAcceptedRequestsReachTheQueueAndRefusalsCom
 
 TEST(RequestServer, MalformedMessagesAndAnotherVersionAreAnsweredThenClosed) {
   Folder folder;
-  RequestServer server({folder.socket()}, -1, limits_refusal);
+  control::CommandRing server_ring;
+  RequestServer server({folder.socket()}, -1, limits_refusal, server_ring);
   std::string error;
   CHECK(server.start(error));
   // A request before Hello.
@@ -157,16 +160,60 @@ TEST(RequestServer, MalformedMessagesAndAnotherVersionAreAnsweredThenClosed) {
   send_message(fd, hello);
   CHECK(receive(fd, answer));
   CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Mismatch);
-  STRCMP_CONTAINS("protocol version 9 from the other side, this side speaks version 1", reason_of(answer).c_str());
+  STRCMP_CONTAINS("protocol version 9 from the other side, this side speaks version 2", reason_of(answer).c_str());
   CHECK_FALSE(receive(fd, answer));
   close(fd);
   CHECK_EQUAL(3U, server.counters().malformed);
 }
 
+TEST(RequestServer, AStopIsNeverRateLimitedAndStopPauseAndResumeReachTheRingAsTheirCommands) {
+  Folder folder;
+  const int feed = memfd_create("feed", MFD_CLOEXEC);
+  control::CommandRing ring;
+  RequestServer server({folder.socket(), 8, 10.0, 2.0}, feed, limits_refusal, ring);
+  std::string error;
+  CHECK(server.start(error));
+  const int fd = connect_to(folder.socket());
+  send_message(fd, make_message(MessageKind::Hello, 0));
+  Message answer{};
+  int passed = -1;
+  CHECK(receive(fd, answer, &passed));
+  close(passed);
+  send_message(fd, make_message(MessageKind::Pause, 1));
+  CHECK(receive(fd, answer));
+  CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Accepted);
+  send_message(fd, make_message(MessageKind::Resume, 2));
+  CHECK(receive(fd, answer));
+  CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Accepted);
+  send_message(fd, make_message(MessageKind::Pause, 3));  // past the burst of 2
+  CHECK(receive(fd, answer));
+  CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Refused);
+  for (std::uint32_t id = 4; id < 8; ++id) {
+    send_message(fd, make_message(MessageKind::Stop, id));
+    CHECK(receive(fd, answer));
+    CHECK_TEXT(static_cast<MessageKind>(answer.kind) == MessageKind::Accepted, reason_of(answer).c_str());
+  }
+  const control::CommandKind expected[] = {control::CommandKind::Pause, control::CommandKind::Resume,
+                                           control::CommandKind::Stop,  control::CommandKind::Stop,
+                                           control::CommandKind::Stop,  control::CommandKind::Stop};
+  for (const control::CommandKind kind : expected) {
+    control::Command command{};
+    CHECK(ring.pop(command));
+    CHECK(command.kind == kind);
+    CHECK(command.source == control::CommandSource::Display);
+  }
+  control::Command none{};
+  CHECK_FALSE(ring.pop(none));
+  CHECK_EQUAL(1U, server.counters().rate_limited);
+  close(fd);
+  close(feed);
+}
+
 TEST(RequestServer, ADisplaySendingTooFastIsRefusedPastItsBurst) {
   Folder folder;
   const int feed = memfd_create("feed", MFD_CLOEXEC);
-  RequestServer server({folder.socket(), 8, 10.0, 5.0, 100}, feed, limits_refusal);
+  control::CommandRing server_ring;
+  RequestServer server({folder.socket(), 8, 10.0, 5.0}, feed, limits_refusal, server_ring);
   std::string error;
   CHECK(server.start(error));
   const int fd = connect_to(folder.socket());
@@ -191,10 +238,12 @@ TEST(RequestServer, ADisplaySendingTooFastIsRefusedPastItsBurst) {
 
 TEST(RequestServer, ALiveSocketIsNeverTakenOverAndAStaleOneIsReplaced) {
   Folder folder;
-  RequestServer first({folder.socket()}, -1, limits_refusal);
+  control::CommandRing first_ring;
+  RequestServer first({folder.socket()}, -1, limits_refusal, first_ring);
   std::string error;
   CHECK(first.start(error));
-  RequestServer second({folder.socket()}, -1, limits_refusal);
+  control::CommandRing second_ring;
+  RequestServer second({folder.socket()}, -1, limits_refusal, second_ring);
   CHECK_FALSE(second.start(error));
   STRCMP_CONTAINS("another controller is serving displays there", error.c_str());
   // A socket left by a controller that died: nobody answers it.
@@ -207,13 +256,15 @@ TEST(RequestServer, ALiveSocketIsNeverTakenOverAndAStaleOneIsReplaced) {
     CHECK(bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof address) == 0);
     close(fd);
   }
-  RequestServer third({stale}, -1, limits_refusal);
+  control::CommandRing third_ring;
+  RequestServer third({stale}, -1, limits_refusal, third_ring);
   CHECK_TRUE_TEXT(third.start(error), error.c_str());
   // Something that is not a socket is never removed.
   const std::string file = (folder.dir / "file").string();
   std::FILE* f = std::fopen(file.c_str(), "w");
   std::fclose(f);
-  RequestServer fourth({file}, -1, limits_refusal);
+  control::CommandRing fourth_ring;
+  RequestServer fourth({file}, -1, limits_refusal, fourth_ring);
   CHECK_FALSE(fourth.start(error));
   STRCMP_CONTAINS("is not a socket", error.c_str());
   CHECK(std::filesystem::exists(file));
@@ -222,7 +273,8 @@ TEST(RequestServer, ALiveSocketIsNeverTakenOverAndAStaleOneIsReplaced) {
 TEST(RequestServer, DisplaysBeyondTheLimitAreClosedAtOnce) {
   Folder folder;
   const int feed = memfd_create("feed", MFD_CLOEXEC);
-  RequestServer server({folder.socket(), 2}, feed, limits_refusal);
+  control::CommandRing server_ring;
+  RequestServer server({folder.socket(), 2}, feed, limits_refusal, server_ring);
   std::string error;
   CHECK(server.start(error));
   const int a = connect_to(folder.socket());

@@ -179,7 +179,14 @@ TEST(HmiRequests, MalformedMessagesAreRefusedWithWhatWasExpected) {
     CHECK_TEXT(!error.empty(), text);
   }
   CHECK_FALSE(parse_request(R"({"type":"launch"})", r, error));
-  CHECK(error.find("expected \"set\" or \"reset\"") != std::string::npos);
+  CHECK(error.find("expected \"set\", \"reset\", \"stop\", \"pause\" or \"resume\"") != std::string::npos);
+  // Stop, pause and resume are requests of their own.
+  CHECK(parse_request(R"({"type":"stop"})", r, error));
+  CHECK(r.kind == RequestKind::Stop);
+  CHECK(parse_request(R"({"type":"pause"})", r, error));
+  CHECK(r.kind == RequestKind::Pause);
+  CHECK(parse_request(R"({"type":"resume"})", r, error));
+  CHECK(r.kind == RequestKind::Resume);
   const std::string huge = R"({"type":"reset","pad":")" + std::string(2000, 'x') + "\"}";
   CHECK_FALSE(parse_request(huge, r, error));
   CHECK(error.find("at most 1024") != std::string::npos);
@@ -293,7 +300,7 @@ TEST(HmiLiveState, StockChangesAreSentAsCellsAndASnapshotCarriesTheWholeGrid) {
   std::vector<float> cells(control::CommandedStock::cells_needed(block, 0.05));
   control::CommandedStock model(block, 0.05, prism.part.tool.spec, cells);
   CHECK(model.ready());
-  linked.link.on_machine(0.1, model);
+  linked.link.on_machine({0.1, {25.0, 12.5, 20.0}, false}, model);
   linked.publish();
   nlohmann::json first = state.frame(1, nlohmann::json::object());
   CHECK(first.contains("stock_grid"));  // the grid's shape is new: sent whole
@@ -301,7 +308,7 @@ TEST(HmiLiveState, StockChangesAreSentAsCellsAndASnapshotCarriesTheWholeGrid) {
   CHECK(columns > 10 && columns <= 100);
   model.cut(Eigen::Vector3d(16.0, 10.0, 5.0), Eigen::Vector3d(20.0, 10.0, 5.0));
   std::this_thread::sleep_for(std::chrono::milliseconds(110));  // the stock is sampled at most 10 times a second
-  linked.link.on_machine(0.2, model);
+  linked.link.on_machine({0.2, {25.0, 12.5, 20.0}, false}, model);
   linked.publish();
   nlohmann::json second = state.frame(2, nlohmann::json::object());
   CHECK_FALSE(second.contains("stock_grid"));

@@ -95,18 +95,23 @@ struct Seen {
   std::vector<JournalResume> resumes;
   std::vector<std::pair<std::uint64_t, SafeReason>> endings;
   JournalStart start;
+  std::vector<stencil::control::CommandSource> sources;  // each safe state's
+  std::vector<stencil::control::CommandEvent> taken;     // the cycle's commands
   JournalVisitor visitor() {
-    return {[this](const JournalStart& s) {
-              ++starts;
-              start = s;
-            },
-            [this](const JournalRecord& r) { cycles.push_back(r); },
-            [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); },
-            [this](std::int64_t t) { homings.push_back(t); },
-            [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); },
-            [this](const JournalResume& r) { resumes.push_back(r); },
-            [this](std::uint64_t c, SafeReason reason) { endings.emplace_back(c, reason); },
-            {}};
+    JournalVisitor v;
+    v.start = [this](const JournalStart& s) {
+      ++starts;
+      start = s;
+    };
+    v.cycle = [this](const JournalRecord& r) { cycles.push_back(r); };
+    v.safe_state = [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); };
+    v.safe_source = [this](std::uint64_t, SafeReason, stencil::control::CommandSource source) { sources.push_back(source); };
+    v.command = [this](const stencil::control::CommandEvent& e) { taken.push_back(e); };
+    v.homed = [this](std::int64_t t) { homings.push_back(t); };
+    v.machine_command = [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); };
+    v.resume = [this](const JournalResume& r) { resumes.push_back(r); };
+    v.end = [this](std::uint64_t c, SafeReason reason) { endings.emplace_back(c, reason); };
+    return v;
   }
 };
 
@@ -256,7 +261,7 @@ TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
   bytes[8] = 9;
   read = read_journal(bytes.data(), bytes.size(), seen.visitor());
   CHECK_FALSE(read.ok);
-  STRCMP_CONTAINS("journal offset 8: version 9; this program reads version 2", read.error.c_str());
+  STRCMP_CONTAINS("journal offset 8: version 9; this program reads versions 2 to 3", read.error.c_str());
   read = read_journal_file("/nonexistent/journal", seen.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());

@@ -48,6 +48,7 @@ const char* type_name(RecordType type) {
     case RecordType::MachineCommand: return "machine command";
     case RecordType::Resume: return "resume";
     case RecordType::End: return "end";
+    case RecordType::Command: return "command";
   }
   return "unknown";
 }

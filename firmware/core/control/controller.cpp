@@ -83,11 +83,13 @@ void Controller::write_zero_force() {
   static_cast<void>(device_.write_command(last_command_));
 }
 
-void Controller::enter_safe_state(SafeReason reason) {
+void Controller::enter_safe_state(SafeReason reason, CommandSource source) {
   if (safe_reason_ != SafeReason::None) {
     return;  // latched: the first reason stays
   }
   safe_reason_ = reason;
+  safe_source_ = source;
+  paused_ = false;  // the stop supersedes a feed hold: after a reset the tool follows again
   ++counters_.safe_state_entries;
   write_zero_force();  // at once, whatever else this cycle still does
 }
@@ -120,6 +122,7 @@ ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
     return hand;
   }
   safe_reason_ = SafeReason::None;
+  safe_source_ = CommandSource::Cycle;
   ramp_start_ns_ = now_ns;
   ramping_ = true;
   consecutive_overruns_ = 0;
@@ -127,32 +130,114 @@ ResetOutcome Controller::try_reset(hal::MonotonicNs now_ns) {
   return ResetOutcome::Accepted;
 }
 
-void Controller::handle_commands(hal::MonotonicNs now_ns) {
+namespace {
+
+CommandOutcome outcome_of(ResetOutcome reset) {
+  switch (reset) {
+    case ResetOutcome::Accepted:
+      return CommandOutcome::Done;
+    case ResetOutcome::NotInSafeState:
+      return CommandOutcome::NotInSafeState;
+    case ResetOutcome::DeviceNotStill:
+      return CommandOutcome::DeviceNotStill;
+    case ResetOutcome::DeviceFarFromTool:
+      return CommandOutcome::DeviceFarFromTool;
+    case ResetOutcome::DeviceNotReady:
+      return CommandOutcome::DeviceNotReady;
+  }
+  return CommandOutcome::Refused;
+}
+
+CommandOutcome outcome_of(ParameterOutcome parameter) {
+  switch (parameter) {
+    case ParameterOutcome::Applied:
+      return CommandOutcome::Done;
+    case ParameterOutcome::Clamped:
+      return CommandOutcome::Clamped;
+    case ParameterOutcome::None:
+    case ParameterOutcome::Refused:
+      break;
+  }
+  return CommandOutcome::Refused;
+}
+
+}  // namespace
+
+double Controller::parameter_value(CommandKind kind) const {
+  switch (kind) {
+    case CommandKind::SetCoupling:
+      return config_.haptic.coupling_n_per_device_mm;
+    case CommandKind::SetForceLimit:
+      return config_.haptic.max_force_n;
+    case CommandKind::SetSpeedLimit:
+      return config_.max_axis_move_mm / config_.period_s;
+    default:
+      return 0.0;
+  }
+}
+
+CommandOutcome Controller::take_command(const Command& command, hal::MonotonicNs now_ns) {
+  switch (command.kind) {
+    case CommandKind::Stop:
+    case CommandKind::JournalFailed: {
+      const bool was_safe = safe_reason_ != SafeReason::None;
+      enter_safe_state(command.kind == CommandKind::Stop ? SafeReason::Stopped : SafeReason::JournalFailed,
+                       command.source);
+      return was_safe ? CommandOutcome::AlreadySafe : CommandOutcome::Done;
+    }
+    case CommandKind::Reset:
+      last_reset_ = try_reset(now_ns);
+      ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
+      return outcome_of(last_reset_);
+    case CommandKind::SetCoupling:
+    case CommandKind::SetForceLimit:
+    case CommandKind::SetSpeedLimit:
+      last_parameter_ = command.kind;
+      last_parameter_outcome_ = set_parameter(command.kind, command.value);
+      ++parameter_requests_;
+      return outcome_of(last_parameter_outcome_);
+    case CommandKind::Pause:
+      if (safe_reason_ != SafeReason::None || waiting_for_hand_) {
+        return CommandOutcome::NotRunning;
+      }
+      if (paused_) {
+        return CommandOutcome::AlreadyPaused;
+      }
+      paused_ = true;
+      return CommandOutcome::Done;
+    case CommandKind::Resume:
+      if (!paused_) {
+        return CommandOutcome::NotPaused;
+      }
+      paused_ = false;
+      return CommandOutcome::Done;
+  }
+  return CommandOutcome::Refused;
+}
+
+void Controller::take_commands(CommandRing& ring, hal::MonotonicNs now_ns) {
+  ring.begin_look(cycle_);
   // Bounded by the ring's capacity: a command pushed while draining waits for the next cycle.
   for (std::size_t i = 0; i < CommandRing::capacity(); ++i) {
     Command command{};
-    if (!rings_.commands.pop(command)) {
+    if (!ring.pop(command)) {
       break;
     }
-    switch (command.kind) {
-      case CommandKind::Stop:
-        enter_safe_state(SafeReason::Stopped);
-        break;
-      case CommandKind::JournalFailed:
-        enter_safe_state(SafeReason::JournalFailed);
-        break;
-      case CommandKind::Reset:
-        last_reset_ = try_reset(now_ns);
-        ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
-        break;
-      case CommandKind::SetCoupling:
-      case CommandKind::SetForceLimit:
-      case CommandKind::SetSpeedLimit:
-        last_parameter_ = command.kind;
-        last_parameter_outcome_ = set_parameter(command.kind, command.value);
-        ++parameter_requests_;
-        break;
+    const CommandOutcome outcome = take_command(command, now_ns);
+    const bool set = parameter_name(command.kind)[0] != 'n';  // a Set*: "none" for the others
+    const CommandEvent event{cycle_,          now_ns,  command.queued_after_cycle,
+                             command.kind,    command.source, outcome,
+                             set ? command.value : 0.0, set ? parameter_value(command.kind) : 0.0};
+    if (!rings_.command_events.push(event)) {
+      enter_safe_state(SafeReason::JournalFull, CommandSource::Cycle);  // the record would lose it: stop cutting
     }
+  }
+}
+
+void Controller::handle_commands(hal::MonotonicNs now_ns) {
+  take_commands(rings_.commands, now_ns);
+  if (rings_.display_commands != nullptr) {
+    take_commands(*rings_.display_commands, now_ns);
   }
   for (std::size_t i = 0; i < MachineEventRing::capacity(); ++i) {
     MachineEvent event{};
@@ -160,9 +245,9 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       break;
     }
     if (event.kind == MachineEventKind::Fault) {
-      enter_safe_state(SafeReason::MachineFault);
+      enter_safe_state(SafeReason::MachineFault, CommandSource::Machine);
     } else if (event.kind == MachineEventKind::JournalFailed) {
-      enter_safe_state(SafeReason::JournalFailed);
+      enter_safe_state(SafeReason::JournalFailed, CommandSource::Machine);
     } else if (event.kind == MachineEventKind::Backlog) {
       backlog_percent_ = event.backlog_percent;
     }
@@ -309,13 +394,17 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
   }
   const Eigen::Vector3d& desired = outcome.desired_tip_mm;
   outcome.contact = tool_.contact_at(desired, config_.contact);
-  const engine::RemediationResult moved = tool_.step(desired, outcome.contact, config_.contact);
+  // Paused: the virtual tool stays where it is (the mill holds there); the hand feels it held by the
+  // same spring that pulls it towards the tool when the tool lags.
+  const engine::RemediationResult moved =
+      paused_ ? engine::RemediationResult{engine::RemediationStatus::Stuck, tool_.tip_mm(), 0, 0, false}
+              : tool_.step(desired, outcome.contact, config_.contact);
   outcome.remediation = moved.status;
   outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic);
   if (outcome.contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
       outcome.output.fault) {
     enter_safe_state(SafeReason::EngineFault);
-  } else {
+  } else if (!paused_) {  // held: nothing new touched, and the hand's distance is the operator's own
     static_cast<void>(engine::mark_touched(part_, contact_tool_, tool_.pose(), touch_distance_mm(config_), touched_));
     max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
   }
@@ -352,7 +441,7 @@ void Controller::publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, 
     enter_safe_state(SafeReason::JournalFull);  // the record is lost: say so, stop cutting
   }
   // The machine side gets every cycle's virtual tool; falling a whole ring behind is a fault.
-  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None};
+  MachineHandoff handoff{cycle_, {}, safe_reason_ != SafeReason::None, paused_};
   copy3(tool_.tip_mm(), handoff.virtual_tip_mm);
   if (!rings_.machine.push(handoff)) {
     enter_safe_state(SafeReason::MachineFault);
@@ -383,6 +472,8 @@ JournalRecord Controller::build_journal_record(hal::MonotonicNs now_ns) const {
   for (int i = 0; i < 3; ++i) {
     record.force_n[i] = static_cast<float>(last_command_.force_n[i]);
   }
+  record.safe_source = safe_source_;
+  record.paused = paused_;
   return record;
 }
 
@@ -413,6 +504,8 @@ Telemetry Controller::build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs 
   telemetry.parameter_requests = parameter_requests_;
   telemetry.last_parameter = last_parameter_;
   telemetry.last_parameter_outcome = last_parameter_outcome_;
+  telemetry.paused = paused_;
+  telemetry.safe_source = safe_source_;
   return telemetry;
 }
 

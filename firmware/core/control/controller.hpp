@@ -113,6 +113,9 @@ class Controller {
   void set_count_overruns(bool on) { config_.count_overruns = on; }
 
   [[nodiscard]] SafeReason safe_reason() const { return safe_reason_; }
+  [[nodiscard]] CommandSource safe_source() const { return safe_source_; }
+  // The operator's feed hold (CommandKind::Pause): the virtual tool held, the mill held.
+  [[nodiscard]] bool paused() const { return paused_; }
   [[nodiscard]] ResetOutcome last_reset() const { return last_reset_; }
   [[nodiscard]] const LoopStatistics& statistics() const { return statistics_; }
   [[nodiscard]] const CycleCounters& counters() const { return counters_; }
@@ -123,9 +126,14 @@ class Controller {
   [[nodiscard]] double max_offset_mm() const { return max_offset_mm_; }  // device vs virtual tool, world
 
  private:
-  void enter_safe_state(SafeReason reason);
+  void enter_safe_state(SafeReason reason, CommandSource source = CommandSource::Cycle);
   void write_zero_force();
+  // Both command rings (the records thread's, then the display's), each command recorded as an event.
   void handle_commands(hal::MonotonicNs now_ns);
+  void take_commands(CommandRing& ring, hal::MonotonicNs now_ns);
+  [[nodiscard]] CommandOutcome take_command(const Command& command, hal::MonotonicNs now_ns);
+  // A parameter as it stands, in its command's unit (speed: mm/s, infinity when unlimited).
+  [[nodiscard]] double parameter_value(CommandKind kind) const;
   [[nodiscard]] ResetOutcome try_reset(hal::MonotonicNs now_ns);
   // The reset rule's hand: still long enough, near enough the virtual tool (Accepted when both).
   [[nodiscard]] ResetOutcome hand_held_near_tool(hal::MonotonicNs now_ns) const;
@@ -169,6 +177,8 @@ class Controller {
 
   std::uint64_t cycle_ = 0;
   SafeReason safe_reason_ = SafeReason::None;
+  CommandSource safe_source_ = CommandSource::Cycle;
+  bool paused_ = false;
   ResetOutcome last_reset_ = ResetOutcome::NotInSafeState;
   hal::HapticSample sample_{};             // the last accepted sample
   hal::ReadResult read_{hal::ReadStatus::Stale, hal::HapticFault::None};  // this cycle's read, for the journal

@@ -2,6 +2,8 @@
 // SpscRing: commands in, and out the machine handoff, telemetry and the journal.
 #pragma once
 
+#include <atomic>
+#include <cstddef>
 #include <cstdint>
 
 #include "firmware/core/control/safe_state.hpp"
@@ -21,12 +23,75 @@ enum class CommandKind : std::uint8_t {
   SetCoupling,    // N per device mm: the pull of the device towards the virtual tool
   SetForceLimit,  // N: never above the board's limit (ControllerConfig::haptic at start-up)
   SetSpeedLimit,  // world mm/s of the virtual tool: never above the mill's (the config's move limits)
+  // Feed hold: the virtual tool stops following the hand (which feels it held in place) and the mill
+  // holds where it is; Resume carries on from there, without a reset or homing.
+  Pause,
+  Resume,
 };
+
+// Where a command (and so a safe state) came from, for the journal, the report and the display.
+enum class CommandSource : std::uint8_t {
+  Cycle,     // no command: the cycle's own checks (the device, the engine, the loop's timing)
+  Machine,   // the machine side (its link's fault, a target it could not record)
+  Program,   // the controller program itself: the job's time is up, the journal failed
+  Signal,    // SIGINT/SIGTERM
+  Terminal,  // the rig's operator terminal
+  Display,   // an operator display
+  Replay,    // a replay of a journal, the safe state its record shows without a command
+};
+
+[[nodiscard]] constexpr const char* command_source_name(CommandSource source) {
+  switch (source) {
+    case CommandSource::Cycle:
+      return "cycle";
+    case CommandSource::Machine:
+      return "machine";
+    case CommandSource::Program:
+      return "program";
+    case CommandSource::Signal:
+      return "signal";
+    case CommandSource::Terminal:
+      return "terminal";
+    case CommandSource::Display:
+      return "display";
+    case CommandSource::Replay:
+      return "replay";
+  }
+  return "unknown";
+}
+inline constexpr std::uint8_t kCommandSourceCount = 7;
 
 struct Command {
   CommandKind kind;
   double value = 0.0;  // the Set* commands' new value
+  CommandSource source = CommandSource::Program;
+  // Stamped by CommandRing::push: how many cycles had begun when it was queued (the cycle that takes
+  // it records both, so the record shows how long it waited).
+  std::uint64_t queued_after_cycle = 0;
 };
+
+[[nodiscard]] constexpr const char* command_kind_name(CommandKind kind) {
+  switch (kind) {
+    case CommandKind::Reset:
+      return "reset";
+    case CommandKind::Stop:
+      return "stop";
+    case CommandKind::JournalFailed:
+      return "journal_failed";
+    case CommandKind::SetCoupling:
+      return "set_coupling";
+    case CommandKind::SetForceLimit:
+      return "set_force_limit";
+    case CommandKind::SetSpeedLimit:
+      return "set_speed_limit";
+    case CommandKind::Pause:
+      return "pause";
+    case CommandKind::Resume:
+      return "resume";
+  }
+  return "unknown";
+}
+inline constexpr std::uint8_t kCommandKindCount = 8;
 
 // The operator's parameter a Set* command sets, by the name the display uses in its requests and
 // its state feed ("coupling", "force_limit", "speed_limit"); "none" for the other commands.
@@ -41,6 +106,8 @@ struct Command {
     case CommandKind::Reset:
     case CommandKind::Stop:
     case CommandKind::JournalFailed:
+    case CommandKind::Pause:
+    case CommandKind::Resume:
       break;
   }
   return "none";
@@ -94,12 +161,70 @@ enum class ResetOutcome : std::uint8_t {
   return "unknown";
 }
 
+// What the cycle made of a command it took, whatever its kind: the journal's and the report's word.
+enum class CommandOutcome : std::uint8_t {
+  Done,               // Stop: the safe state entered; Pause, Resume: done; Reset: accepted; Set*: applied as asked
+  Clamped,            // Set*: the board's limit (or the least) applies instead
+  Refused,            // Set*: not a finite positive number, nothing changed
+  AlreadySafe,        // Stop, JournalFailed: the safe state was latched already (its first reason stays)
+  NotInSafeState,     // Reset: nothing to reset
+  DeviceNotStill,     // Reset: see ResetOutcome
+  DeviceFarFromTool,
+  DeviceNotReady,
+  NotRunning,         // Pause: the cycle is in its safe state or waits for the hand
+  AlreadyPaused,
+  NotPaused,          // Resume
+};
+inline constexpr std::uint8_t kCommandOutcomeCount = 11;
+
+[[nodiscard]] constexpr const char* command_outcome_name(CommandOutcome outcome) {
+  switch (outcome) {
+    case CommandOutcome::Done:
+      return "done";
+    case CommandOutcome::Clamped:
+      return "clamped";
+    case CommandOutcome::Refused:
+      return "refused";
+    case CommandOutcome::AlreadySafe:
+      return "already_safe";
+    case CommandOutcome::NotInSafeState:
+      return "not_in_safe_state";
+    case CommandOutcome::DeviceNotStill:
+      return "device_not_still";
+    case CommandOutcome::DeviceFarFromTool:
+      return "device_far_from_tool";
+    case CommandOutcome::DeviceNotReady:
+      return "device_not_ready";
+    case CommandOutcome::NotRunning:
+      return "not_running";
+    case CommandOutcome::AlreadyPaused:
+      return "already_paused";
+    case CommandOutcome::NotPaused:
+      return "not_paused";
+  }
+  return "unknown";
+}
+
+// One command the cycle took, for the journal (a record of its own: a replay gives the cycle the
+// same commands at the same cycles), the report and the display's event list.
+struct CommandEvent {
+  std::uint64_t cycle;               // the cycle that took it
+  std::int64_t time_ns;              // that cycle's start
+  std::uint64_t queued_after_cycle;  // cycles begun when it was queued: cycle - this is its wait
+  CommandKind kind;
+  CommandSource source;
+  CommandOutcome outcome;
+  double asked;    // Set*: the value asked (its unit); else 0
+  double applied;  // Set*: the value in force after it (the same unit; unlimited speed: infinity)
+};
+
 // Every cycle, to the machine side: where the virtual tool is (world mm, always legal) and whether
 // the machine must stop.
 struct MachineHandoff {
   std::uint64_t cycle;
   double virtual_tip_mm[3];
   bool safe_state;  // hold the feed, then switch the drivers off; move nothing until reset
+  bool paused;      // feed hold: the mill holds where it is and takes no target until this clears
 };
 
 // From the machine side, when something happens there.
@@ -145,6 +270,8 @@ struct Telemetry {
   std::uint32_t parameter_requests;
   CommandKind last_parameter;
   ParameterOutcome last_parameter_outcome;
+  bool paused;                  // the operator's feed hold
+  CommandSource safe_source;    // where the safe state came from (Cycle when none)
 };
 
 // Everything a replay needs and nothing is allowed to lose: the journal ring being full is a fault.
@@ -164,22 +291,52 @@ struct JournalRecord {
   std::uint16_t status_bits;
   hal::ReadStatus read_status;
   hal::HapticFault read_reason;
+  // Not in the Cycle record's bytes: the writer puts them in the SafeState record it writes with the
+  // first record in the safe state, and the paused flag shows in the Pause and Resume records.
+  CommandSource safe_source;
+  bool paused;
 };
 
 // The rings around the cycle: capacities in the types. The machine side drains its ring at each
 // machine update (about 30 Hz), so it holds well over a machine update's worth of cycles.
-using CommandRing = SpscRing<Command, 16>;
 using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
 using MachineEventRing = SpscRing<MachineEvent, 16>;
 using TelemetryRing = SpscRing<Telemetry, 64>;
 using JournalRing = SpscRing<JournalRecord, 4096>;
+// At most both command rings' worth a cycle, and the records thread drains it with the journal's.
+using CommandEventRing = SpscRing<CommandEvent, 64>;
+
+// Commands into the cycle from one producer thread. It stamps each with the cycles the cycle had
+// begun (the cycle tells it at each look), so the record shows how long a command waited.
+class CommandRing {
+ public:
+  static constexpr std::size_t kCapacity = 16;
+  [[nodiscard]] static constexpr std::size_t capacity() { return kCapacity; }
+  // The producer. Real-time safe.
+  [[nodiscard]] bool push(Command command) {
+    command.queued_after_cycle = cycles_begun_.load(std::memory_order_relaxed);
+    return ring_.push(command);
+  }
+  // The cycle: its count first, then what is queued.
+  void begin_look(std::uint64_t cycle) { cycles_begun_.store(cycle, std::memory_order_relaxed); }
+  [[nodiscard]] bool pop(Command& command) { return ring_.pop(command); }
+  [[nodiscard]] std::size_t size() const { return ring_.size(); }
+
+ private:
+  SpscRing<Command, kCapacity> ring_;
+  std::atomic<std::uint64_t> cycles_begun_{0};
+};
 
 struct CycleRings {
-  CommandRing& commands;          // in: reset, stop
+  CommandRing& commands;          // in: reset, stop, ... from the records thread (signals, terminal, program)
   MachineEventRing& machine_events;  // in: the machine side's faults
   MachineHandoffRing& machine;    // out: every cycle's virtual tool
   TelemetryRing& telemetry;       // out: dropped and counted when full
   JournalRing& journal;           // out: full is a fault
+  CommandEventRing& command_events;  // out: each command taken; full is a fault (the record would lose it)
+  // in: an operator display's requests, pushed by its own server thread (so a Stop is taken by the
+  // next cycle, not at the records thread's next look); null when there is no display.
+  CommandRing* display_commands = nullptr;
 };
 
 // The rings of one cycle, owned together: a board allocates one of these at start-up (they are
@@ -190,7 +347,10 @@ struct CycleRingStorage {
   MachineHandoffRing machine;
   TelemetryRing telemetry;
   JournalRing journal;
-  [[nodiscard]] CycleRings rings() { return {commands, machine_events, machine, telemetry, journal}; }
+  CommandEventRing command_events;
+  [[nodiscard]] CycleRings rings(CommandRing* display_commands = nullptr) {
+    return {commands, machine_events, machine, telemetry, journal, command_events, display_commands};
+  }
 };
 
 }  // namespace stencil::control

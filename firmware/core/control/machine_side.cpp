@@ -51,12 +51,14 @@ void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineE
 void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   // Every handoff since the last update, in order: the planner follows the virtual tool's path.
   bool safe_state = false;
+  bool paused = held_;  // no handoff since the last update: as it was
   for (std::size_t i = 0; i < MachineHandoffRing::capacity(); ++i) {
     MachineHandoff handoff{};
     if (!from_cycle_.pop(handoff)) {
       break;
     }
     safe_state = safe_state || handoff.safe_state;
+    paused = handoff.paused;  // the newest says
     if (state_ == MachineSideState::Cutting && !handoff.safe_state) {
       const Eigen::Vector3d tip(handoff.virtual_tip_mm[0], handoff.virtual_tip_mm[1], handoff.virtual_tip_mm[2]);
       if (planner_.follow(tip) == motion::PathStatus::Full) {
@@ -84,6 +86,22 @@ void MachineSide::update(hal::MonotonicNs update_deadline_ns) {
   if (!link_.keep_alive(update_deadline_ns).done) {  // the watchdog relay's heartbeat, every update
     stop(update_deadline_ns, true);
     return;
+  }
+  // The operator's feed hold: the link refuses moves from here (each lasts at most an update, so the
+  // mill is still by the next one); nothing is planned, recorded or sent until it is lifted, and then
+  // the mill carries on along the path it held, with no homing.
+  if (paused) {
+    if (!held_) {
+      link_.hold();
+      held_ = true;
+      ++statistics_.holds;
+    }
+    ++statistics_.held_updates;
+    return;
+  }
+  if (held_) {
+    link_.resume();
+    held_ = false;
   }
   // A target queued for the record at an earlier update goes out in this one once it is written;
   // until then the mill holds (this update keeps its deadline: nothing here waits on the record's

@@ -29,6 +29,8 @@ struct MachineSideStatistics {
   double last_lag_mm = 0.0;       // the same at the newest update
   std::int64_t motor_steps = 0;   // all axes, take-up included
   std::uint64_t held_for_record = 0;  // updates the mill held: the newest target not yet in the record
+  std::uint64_t holds = 0;            // the operator's feed holds (pauses) taken to the link
+  std::uint64_t held_updates = 0;     // updates in them: nothing sent
 };
 
 class MachineSide {
@@ -62,6 +64,8 @@ class MachineSide {
   // Queued points of the virtual tool's path the mill has not reached yet (0: drained).
   [[nodiscard]] std::size_t path_left() const { return planner_.path_size(); }
   [[nodiscard]] bool at_goal() const { return at_goal_; }
+  // The operator's feed hold is on at the link (the cycle is paused).
+  [[nodiscard]] bool held() const { return held_; }
   [[nodiscard]] const motion::MachinePlanner& planner() const { return planner_; }
 
   // The model of the machined stock this side keeps from the targets it sends (null: none). Set
@@ -110,6 +114,7 @@ class MachineSide {
   MachineSideState state_ = MachineSideState::NotStarted;
   std::uint64_t moves_seen_ = 0;
   bool at_goal_ = false;
+  bool held_ = false;
   MachineSideStatistics statistics_;
   CommandedStock* stock_ = nullptr;
   MachineRecorder* recorder_ = nullptr;

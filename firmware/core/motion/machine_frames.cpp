@@ -35,4 +35,12 @@ Eigen::Vector3d steps_to_world(const MachineFrames& frames, const MachineSteps& 
   return world;
 }
 
+Eigen::Vector3d world_to_machine_mm(const MachineFrames& frames, const Eigen::Vector3d& world_mm) {
+  Eigen::Vector3d machine;
+  for (int i = 0; i < 3; ++i) {
+    machine[i] = frames.machine_sign[static_cast<std::size_t>(i)] * (world_mm[i] - frames.home_world_mm[i]);
+  }
+  return machine;
+}
+
 }  // namespace stencil::motion

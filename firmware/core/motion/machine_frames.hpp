@@ -34,6 +34,9 @@ struct MachineFrames {
 // a coordinate is not finite or beyond what 24 bits of steps can hold (the CY545's range).
 [[nodiscard]] bool world_to_steps(const MachineFrames& frames, const Eigen::Vector3d& world_mm, MachineSteps& steps);
 [[nodiscard]] Eigen::Vector3d steps_to_world(const MachineFrames& frames, const MachineSteps& steps);
+// A world point in machine coordinates (mm from home along each machine axis, its sign), as a
+// machine's position readout shows it: the motor steps it takes, over the steps per mm, unrounded.
+[[nodiscard]] Eigen::Vector3d world_to_machine_mm(const MachineFrames& frames, const Eigen::Vector3d& world_mm);
 
 // The CY545 holds positions and step counts in 24 bits (signed here).
 inline constexpr std::int32_t kMaxMachineSteps = (1 << 23) - 1;

@@ -103,10 +103,15 @@ bool DisplayLink::start(std::string& error) {
   }
   publish(true);
   feed_.publish(*stock_);
+  // The mill at home until its first update (machine coordinates 0).
+  for (int i = 0; i < 3; ++i) {
+    machine_.work_mm[i] = config_.frames.home_world_mm[i];
+  }
+  feed_.publish(machine_);
   RequestServerOptions server_options;
   server_options.socket_path = options_.socket_path;
-  server_ = std::make_unique<RequestServer>(server_options, feed_.fd(),
-                                            [this](const Request& request) { return decide(request); });
+  server_ = std::make_unique<RequestServer>(
+      server_options, feed_.fd(), [this](const Request& request) { return decide(request); }, commands_);
   if (!server_->start(error)) {
     server_.reset();
     return false;
@@ -136,9 +141,15 @@ std::string DisplayLink::decide(const Request& request) const {
   if (request.kind == RequestKind::Set) {
     return refusal(request, own_view_.header().limits);
   }
+  if (request.kind == RequestKind::Stop) {
+    return "";  // always: in the safe state already, the cycle keeps its first reason
+  }
   Figures now{};
   if (!own_view_.read(now)) {
     return "the controller is busy; try again";
+  }
+  if (request.kind == RequestKind::Pause || request.kind == RequestKind::Resume) {
+    return pause_refusal(request.kind, now.have_telemetry != 0, now.telemetry);
   }
   return reset_refusal(now.have_telemetry != 0, now.telemetry, own_view_.header().reset_rule);
 }
@@ -184,12 +195,35 @@ void DisplayLink::on_record(const control::JournalRecord& record) {
   f.probe_mm[1] = probe.y();
   f.probe_mm[2] = probe.z();
   std::copy(std::begin(record.force_n), std::end(record.force_n), f.force_n);
+  std::copy(std::begin(record.device_mm), std::end(record.device_mm), f.device_mm);
+  const Eigen::Vector3d machine = motion::world_to_machine_mm(
+      config_.frames, Eigen::Vector3d(record.virtual_tip_mm[0], record.virtual_tip_mm[1], record.virtual_tip_mm[2]));
+  f.virtual_machine_mm[0] = machine.x();
+  f.virtual_machine_mm[1] = machine.y();
+  f.virtual_machine_mm[2] = machine.z();
   f.record_safe_reason = record.safe_reason;
+  if (record.safe_reason != control::SafeReason::None && !in_safe_state_) {
+    add_event(FeedEvent{record.cycle, record.time_ns, FeedEventType::SafeState, control::CommandKind::Stop,
+                        record.safe_source, control::CommandOutcome::Done, record.safe_reason, {}, 0.0, 0.0});
+  }
+  in_safe_state_ = record.safe_reason != control::SafeReason::None;
   f.touched_count = static_cast<std::uint32_t>(touched_->count());
   const float force = std::sqrt(record.force_n[0] * record.force_n[0] + record.force_n[1] * record.force_n[1] +
                                 record.force_n[2] * record.force_n[2]);
   feed_.record_force(record.cycle, force);
   publish(false);
+}
+
+void DisplayLink::on_command(const control::CommandEvent& event) {
+  add_event(FeedEvent{event.cycle, event.time_ns, FeedEventType::Command, event.kind, event.source, event.outcome,
+                      control::SafeReason::None, {}, event.asked, event.applied});
+  publish(true);  // an operator waits to see what came of it
+}
+
+void DisplayLink::add_event(const FeedEvent& event) {
+  Figures& f = *figures_;
+  f.events[f.events_total % kFeedEvents] = event;
+  ++f.events_total;
 }
 
 void DisplayLink::on_telemetry(const control::Telemetry& telemetry) {
@@ -207,7 +241,19 @@ void DisplayLink::on_telemetry(const control::Telemetry& telemetry) {
   publish(false);
 }
 
-void DisplayLink::on_machine(double lag_mm, const control::CommandedStock& model) {
+void DisplayLink::on_machine(const control::MachineView& machine, const control::CommandedStock& model) {
+  // The position, every update (small); the stock, at most ten times a second (large).
+  ++machine_.updates;
+  machine_.lag_mm = machine.lag_mm;
+  std::copy(std::begin(machine.commanded_tip_mm), std::end(machine.commanded_tip_mm), machine_.work_mm);
+  const Eigen::Vector3d in_machine = motion::world_to_machine_mm(
+      config_.frames, Eigen::Vector3d(machine.commanded_tip_mm[0], machine.commanded_tip_mm[1], machine.commanded_tip_mm[2]));
+  machine_.machine_mm[0] = in_machine.x();
+  machine_.machine_mm[1] = in_machine.y();
+  machine_.machine_mm[2] = in_machine.z();
+  machine_.held = machine.held ? 1 : 0;
+  feed_.publish(machine_);
+  const double lag_mm = machine.lag_mm;
   const auto now = std::chrono::steady_clock::now();
   if (sampled_ != std::chrono::steady_clock::time_point{} && now - sampled_ < kStockEvery) {
     return;
@@ -218,8 +264,6 @@ void DisplayLink::on_machine(double lag_mm, const control::CommandedStock& model
   ++stock_->grid.updates;
   feed_.publish(*stock_);
 }
-
-bool DisplayLink::pop_command(control::Command& command) { return server_ != nullptr && server_->pop_command(command); }
 
 RequestCounters DisplayLink::counters() const { return server_ != nullptr ? server_->counters() : figures_->requests; }
 

@@ -46,10 +46,11 @@ class DisplayLink final : public control::DisplayFeed {
 
   // control::DisplayFeed, from the boards' threads.
   void on_record(const control::JournalRecord& record) override;
+  void on_command(const control::CommandEvent& event) override;
   void on_telemetry(const control::Telemetry& telemetry) override;
-  void on_machine(double lag_mm, const control::CommandedStock& model) override;
+  void on_machine(const control::MachineView& machine, const control::CommandedStock& model) override;
   void seed_touched(const engine::TriangleSet& touched) override;
-  [[nodiscard]] bool pop_command(control::Command& command) override;
+  [[nodiscard]] control::CommandRing& commands() override { return commands_; }
 
   [[nodiscard]] RequestCounters counters() const;
   [[nodiscard]] const std::string& socket_path() const { return options_.socket_path; }
@@ -59,6 +60,7 @@ class DisplayLink final : public control::DisplayFeed {
   static void heard_touched(void* self, std::uint32_t id);
   [[nodiscard]] std::string decide(const Request& request) const;
   void publish(bool now);
+  void add_event(const FeedEvent& event);
 
   const tables::PartTables& part_;
   control::ControllerConfig config_;
@@ -68,9 +70,12 @@ class DisplayLink final : public control::DisplayFeed {
   std::unique_ptr<engine::TriangleSet> touched_;  // the mirror of the cycle's set
   std::unique_ptr<Figures> figures_;              // the records thread's, published behind the seqlock
   std::unique_ptr<FeedStock> stock_;              // the machine thread's
+  FeedMachine machine_{};                         // the machine thread's
+  bool in_safe_state_ = false;                    // the records thread's: the newest record was
   std::chrono::steady_clock::time_point published_{}, sampled_{};
   FeedWriter feed_;
   FeedView own_view_;  // the reset rule reads the newest telemetry back from the feed: no lock
+  control::CommandRing commands_;  // the server thread pushes, the cycle pops; outlives both
   std::unique_ptr<RequestServer> server_;
 };
 

@@ -3,8 +3,9 @@
 //
 //  - Requests, over a Unix-domain socket in the controller's run folder (owner-only): fixed-size,
 //    versioned Messages both ways. A display says Hello; the controller answers Welcome with the
-//    state feed's file descriptor (SCM_RIGHTS), or Mismatch naming both versions. Then Set and Reset,
-//    each answered Accepted or Refused (with the reason) and echoing the display's id.
+//    state feed's file descriptor (SCM_RIGHTS), or Mismatch naming both versions. Then Set, Reset,
+//    Stop, Pause and Resume, each answered Accepted or Refused (with the reason) and echoing the
+//    display's id.
 //  - The state feed: a sealed memfd the display maps read-only. A FeedHeader written once at
 //    start-up (the part's mesh, the limits), then Figures and the stock behind seqlocks, the touched
 //    set as bits that are only ever set, and each cycle's force in a ring. The controller's threads
@@ -22,7 +23,7 @@
 namespace stencil::display_link {
 
 // Any change to a Message or to the feed's layout changes this.
-inline constexpr std::uint16_t kProtocolVersion = 1;
+inline constexpr std::uint16_t kProtocolVersion = 2;
 
 // ---- the request channel ----
 
@@ -33,6 +34,9 @@ enum class MessageKind : std::uint8_t {
   Hello = 1,     // display -> controller, first
   Set = 2,       // display -> controller: parameter, value
   Reset = 3,     // display -> controller
+  Stop = 4,      // display -> controller: never rate-limited
+  Pause = 5,     // display -> controller: feed hold
+  Resume = 6,    // display -> controller
   Welcome = 16,  // controller -> display, with the feed's descriptor
   Accepted = 17,
   Refused = 18,  // reason: why
@@ -79,6 +83,21 @@ struct RequestCounters {
 
 enum class JobPhase : std::uint8_t { Running = 0, Ended = 1 };
 
+// The event list: the newest kFeedEvents of the commands the cycle took and the safe states it entered.
+inline constexpr std::uint32_t kFeedEvents = 32;
+enum class FeedEventType : std::uint8_t { Command = 0, SafeState = 1 };
+struct FeedEvent {
+  std::uint64_t cycle;
+  std::int64_t time_ns;
+  FeedEventType type;
+  control::CommandKind kind;        // Command
+  control::CommandSource source;    // both: where it came from
+  control::CommandOutcome outcome;  // Command
+  control::SafeReason reason;       // SafeState
+  std::uint8_t pad[3];
+  double asked, applied;            // a parameter's, its command's unit
+};
+
 // Everything but the stock and the touched set, as of the newest record the records thread drained.
 struct Figures {
   std::uint64_t records;          // drained so far
@@ -87,6 +106,8 @@ struct Figures {
   std::int64_t time_ns;
   double virtual_tip_mm[3];       // world
   double probe_mm[3];             // the device's tip in world
+  double device_mm[3];            // the device's tip, device space (the newest record's)
+  double virtual_machine_mm[3];   // the virtual tool in machine coordinates (mm from home)
   float force_n[3];
   control::SafeReason record_safe_reason;
   std::uint8_t have_record;
@@ -99,6 +120,18 @@ struct Figures {
   std::uint32_t reachable_touched;
   RequestCounters requests;
   char end_text[160];             // Ended: how the job ended
+  std::uint64_t events_total;     // ever; the newest kFeedEvents are in events[total % kFeedEvents]
+  FeedEvent events[kFeedEvents];
+};
+
+// The mill as the machine thread left it at its newest update.
+struct FeedMachine {
+  std::uint64_t updates;
+  double lag_mm;
+  double work_mm[3];     // the last target sent: the tool tip in the part's (work) coordinates
+  double machine_mm[3];  // the same in machine coordinates (mm from home)
+  std::uint8_t held;     // the operator's feed hold is on at the link
+  std::uint8_t pad[7];
 };
 
 struct StockGridHeader {
@@ -119,7 +152,7 @@ struct FeedHeader {
   std::uint16_t reserved;
   std::uint64_t total_bytes;
   // The sizes the writer was built with: a reader built otherwise refuses the feed.
-  std::uint32_t header_bytes, figures_bytes, stock_bytes, telemetry_bytes;
+  std::uint32_t header_bytes, figures_bytes, stock_bytes, telemetry_bytes, machine_bytes, pad2;
   std::uint64_t job_id;           // the controller's start, ns: a display tells a new job from the same
   std::uint32_t controller_pid;
   char program[32];               // "stencil-sim"
@@ -133,18 +166,20 @@ struct FeedHeader {
   double tool_diameter_mm;
   double workspace_mm[3];
   std::uint64_t mesh_offset, flags_offset, touched_offset, force_ring_offset;
-  std::uint64_t figures_offset, stock_offset;
+  std::uint64_t figures_offset, stock_offset, machine_offset;
 };
 
 // The feed's regions, laid out from a triangle count (both sides compute it; the reader checks it
 // against the header).
 struct FeedLayout {
-  std::uint64_t mesh_offset, flags_offset, touched_offset, force_ring_offset, figures_offset, stock_offset, total_bytes;
+  std::uint64_t mesh_offset, flags_offset, touched_offset, force_ring_offset, figures_offset, stock_offset,
+      machine_offset, total_bytes;
 };
 [[nodiscard]] FeedLayout feed_layout(std::uint32_t triangle_count);
 
 using FiguresCell = Seqlock<Figures>;
 using StockCell = Seqlock<FeedStock>;
+using MachineCell = Seqlock<FeedMachine>;
 // The newest cycle whose force is in the ring, and the ring: entry cycle % kForceRing, bits of a float.
 struct ForceRing {
   std::uint64_t newest_cycle;

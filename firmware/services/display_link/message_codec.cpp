@@ -11,6 +11,9 @@ bool known_kind(std::uint8_t kind) {
     case MessageKind::Hello:
     case MessageKind::Set:
     case MessageKind::Reset:
+    case MessageKind::Stop:
+    case MessageKind::Pause:
+    case MessageKind::Resume:
     case MessageKind::Welcome:
     case MessageKind::Accepted:
     case MessageKind::Refused:
@@ -80,8 +83,9 @@ DecodeResult decode_request(const unsigned char* bytes, std::size_t size, Messag
     return result;
   }
   const auto kind = static_cast<MessageKind>(message.kind);
-  if (kind != MessageKind::Hello && kind != MessageKind::Set && kind != MessageKind::Reset) {
-    error = at(offsetof(Message, kind), "kind " + std::to_string(message.kind) + " is an answer: a display sends Hello, Set or Reset");
+  if (static_cast<std::uint8_t>(kind) >= static_cast<std::uint8_t>(MessageKind::Welcome)) {
+    error = at(offsetof(Message, kind),
+               "kind " + std::to_string(message.kind) + " is an answer: a display sends Hello, Set, Reset, Stop, Pause or Resume");
     return DecodeResult::Malformed;
   }
   return DecodeResult::Ok;
@@ -110,10 +114,18 @@ Message make_answer(MessageKind kind, std::uint32_t id, const std::string& reaso
 }
 
 Request request_of(const Message& message) {
-  if (static_cast<MessageKind>(message.kind) == MessageKind::Set) {
-    return Request{RequestKind::Set, static_cast<Parameter>(message.parameter), message.value};
+  switch (static_cast<MessageKind>(message.kind)) {
+    case MessageKind::Set:
+      return Request{RequestKind::Set, static_cast<Parameter>(message.parameter), message.value};
+    case MessageKind::Stop:
+      return Request{RequestKind::Stop, Parameter::Coupling, 0.0};
+    case MessageKind::Pause:
+      return Request{RequestKind::Pause, Parameter::Coupling, 0.0};
+    case MessageKind::Resume:
+      return Request{RequestKind::Resume, Parameter::Coupling, 0.0};
+    default:
+      return Request{RequestKind::Reset, Parameter::Coupling, 0.0};
   }
-  return Request{RequestKind::Reset, Parameter::Coupling, 0.0};
 }
 
 std::string reason_of(const Message& message) {

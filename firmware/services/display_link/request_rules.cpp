@@ -41,8 +41,20 @@ control::CommandKind command_kind(Parameter parameter) {
 }
 
 control::Command command_of(const Request& request) {
-  return request.kind == RequestKind::Reset ? control::Command{control::CommandKind::Reset, 0.0}
-                                            : control::Command{command_kind(request.parameter), request.value};
+  constexpr auto kDisplay = control::CommandSource::Display;
+  switch (request.kind) {
+    case RequestKind::Set:
+      return {command_kind(request.parameter), request.value, kDisplay};
+    case RequestKind::Reset:
+      return {control::CommandKind::Reset, 0.0, kDisplay};
+    case RequestKind::Stop:
+      return {control::CommandKind::Stop, 0.0, kDisplay};
+    case RequestKind::Pause:
+      return {control::CommandKind::Pause, 0.0, kDisplay};
+    case RequestKind::Resume:
+      return {control::CommandKind::Resume, 0.0, kDisplay};
+  }
+  return {control::CommandKind::Stop, 0.0, kDisplay};  // unreachable: a stop is the safe guess
 }
 
 std::string refusal(const Request& request, const RequestLimits& limits) {
@@ -72,6 +84,23 @@ std::string refusal(const Request& request, const RequestLimits& limits) {
         return number(value) + " mm/s is above what the mill follows, " + number(limits.mill_speed_mm_per_s) + " mm/s";
       }
       break;
+  }
+  return "";
+}
+
+std::string pause_refusal(RequestKind kind, bool have, const control::Telemetry& telemetry) {
+  if (!have) {
+    return "the job has not started yet";
+  }
+  if (telemetry.safe_reason != control::SafeReason::None) {
+    return std::string("the cycle is in its safe state (") + control::safe_reason_name(telemetry.safe_reason) +
+           "): nothing is moving";
+  }
+  if (kind == RequestKind::Pause && telemetry.paused) {
+    return "already paused";
+  }
+  if (kind == RequestKind::Resume && !telemetry.paused) {
+    return "not paused";
   }
   return "";
 }

@@ -10,7 +10,7 @@
 
 namespace stencil::display_link {
 
-enum class RequestKind : std::uint8_t { Set, Reset };
+enum class RequestKind : std::uint8_t { Set, Reset, Stop, Pause, Resume };
 enum class Parameter : std::uint8_t { Coupling, ForceLimit, SpeedLimit };
 inline constexpr int kParameterCount = 3;
 
@@ -43,6 +43,10 @@ struct ResetRule {
 // Why a Set request may not go to the cycle ("50 N is above the board's force limit of 5 N"), or ""
 // when it may.
 [[nodiscard]] std::string refusal(const Request& request, const RequestLimits& limits);
+
+// Why a pause or a resume may not be asked now ("" when it may), from the newest telemetry: the
+// cycle's state decides again when it takes it.
+[[nodiscard]] std::string pause_refusal(RequestKind kind, bool have, const control::Telemetry& telemetry);
 
 // Why a reset may not be asked now ("" when it may), from the newest telemetry (`have` false: none
 // yet): the threads' decision; the cycle's rule has the last word.

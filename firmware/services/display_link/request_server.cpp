@@ -43,8 +43,8 @@ struct RequestServer::Peer {
   double refilled_s = 0.0;
 };
 
-RequestServer::RequestServer(RequestServerOptions options, int feed_fd, Decide decide)
-    : options_(std::move(options)), feed_fd_(feed_fd), decide_(std::move(decide)) {}
+RequestServer::RequestServer(RequestServerOptions options, int feed_fd, Decide decide, control::CommandRing& commands)
+    : options_(std::move(options)), feed_fd_(feed_fd), decide_(std::move(decide)), commands_(commands) {}
 
 RequestServer::~RequestServer() { stop(); }
 
@@ -116,16 +116,6 @@ void RequestServer::stop() {
     close(wake_fd_);
     wake_fd_ = -1;
   }
-}
-
-bool RequestServer::pop_command(control::Command& command) {
-  const std::lock_guard<std::mutex> lock(commands_mutex_);
-  if (commands_.empty()) {
-    return false;
-  }
-  command = commands_.front();
-  commands_.pop_front();
-  return true;
 }
 
 RequestCounters RequestServer::counters() const {
@@ -248,20 +238,17 @@ void RequestServer::handle(Peer& peer, const Message& message) {
   peer.tokens = std::min(options_.request_burst, peer.tokens + (now - peer.refilled_s) * options_.requests_per_s);
   peer.refilled_s = now;
   std::string refusal;
-  if (peer.tokens < 1.0) {
+  const Request request = request_of(message);
+  // A stop is never refused for coming too fast: it is what an operator presses again and again.
+  if (request.kind != RequestKind::Stop && peer.tokens < 1.0) {
     ++rate_limited_;
     refusal = "too many requests: at most " + std::to_string(static_cast<int>(options_.requests_per_s)) + " a second";
   } else {
-    peer.tokens -= 1.0;
-    const Request request = request_of(message);
+    peer.tokens = std::max(0.0, peer.tokens - 1.0);
     refusal = decide_ ? decide_(request) : std::string();
-    if (refusal.empty()) {
-      const std::lock_guard<std::mutex> lock(commands_mutex_);
-      if (commands_.size() >= options_.max_waiting) {
-        refusal = "too many requests waiting for the cycle; try again";
-      } else {
-        commands_.push_back(command_of(request));
-      }
+    // Straight into the cycle's ring: the next cycle takes it (this thread is the ring's one producer).
+    if (refusal.empty() && !commands_.push(command_of(request))) {
+      refusal = "too many requests waiting for the cycle; try again";
     }
     if (!refusal.empty()) {
       ++refused_;

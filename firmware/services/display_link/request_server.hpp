@@ -1,8 +1,9 @@
 // The controller's end of the request channel: a Unix-domain socket (owner-only) that displays of
 // the same user connect to, served on a thread of its own (never the cycle's). Each display says
-// Hello and gets the state feed's descriptor; each Set or Reset it sends is decoded (every byte
-// checked), rate-limited, decided (the limits and the reset rule) and, if accepted, queued for the
-// cycle's command ring; every display gets an answer. Nothing here waits for a display: a display
+// Hello and gets the state feed's descriptor; each request it sends is decoded (every byte
+// checked), rate-limited (a Stop never is), decided (the limits, the reset rule, the cycle's state)
+// and, if accepted, pushed into the display's command ring, which the cycle drains each period;
+// every display gets an answer. Nothing here waits for a display: a display
 // that does not take its answers is dropped.
 #pragma once
 
@@ -24,7 +25,6 @@ struct RequestServerOptions {
   int max_displays = 8;            // more are closed at once (counted in peers_refused)
   double requests_per_s = 10.0;    // each display's steady rate; more are refused
   double request_burst = 10.0;
-  std::size_t max_waiting = 16;    // accepted but not yet taken by the command ring
 };
 
 class RequestServer {
@@ -32,7 +32,8 @@ class RequestServer {
   // Why `request` may not go to the cycle, or "" to accept it (called on the server's thread).
   using Decide = std::function<std::string(const Request& request)>;
 
-  RequestServer(RequestServerOptions options, int feed_fd, Decide decide);
+  // `commands` is the cycle's ring for the displays: this server's thread is its one producer.
+  RequestServer(RequestServerOptions options, int feed_fd, Decide decide, control::CommandRing& commands);
   ~RequestServer();  // stop()
   RequestServer(const RequestServer&) = delete;
   RequestServer& operator=(const RequestServer&) = delete;
@@ -42,8 +43,6 @@ class RequestServer {
   [[nodiscard]] bool start(std::string& error);
   void stop();  // closes every connection, removes the socket, joins
 
-  // The accepted requests, oldest first, for the command ring's producer.
-  [[nodiscard]] bool pop_command(control::Command& command);
   [[nodiscard]] RequestCounters counters() const;
   [[nodiscard]] const std::string& path() const { return options_.socket_path; }
 
@@ -63,8 +62,7 @@ class RequestServer {
   std::thread thread_;
   std::atomic<bool> stopping_{false};
 
-  std::mutex commands_mutex_;
-  std::deque<control::Command> commands_;
+  control::CommandRing& commands_;
 
   std::atomic<std::uint64_t> connected_{0}, seen_{0}, accepted_{0}, refused_{0}, rate_limited_{0}, malformed_{0},
       peers_refused_{0};

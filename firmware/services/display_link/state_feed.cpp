@@ -33,6 +33,8 @@ FeedLayout feed_layout(std::uint32_t triangle_count) {
   at = align(at + sizeof(FiguresCell));
   layout.stock_offset = at;
   at = align(at + sizeof(StockCell));
+  layout.machine_offset = at;
+  at = align(at + sizeof(MachineCell));
   layout.total_bytes = (at + 4095) & ~std::uint64_t{4095};
   return layout;
 }
@@ -75,6 +77,7 @@ bool FeedWriter::create(const tables::PartTables& part, const FeedFacts& facts, 
   h.figures_bytes = sizeof(Figures);
   h.stock_bytes = sizeof(FeedStock);
   h.telemetry_bytes = sizeof(control::Telemetry);
+  h.machine_bytes = sizeof(FeedMachine);
   h.job_id = static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count());
   h.controller_pid = static_cast<std::uint32_t>(getpid());
@@ -92,6 +95,7 @@ bool FeedWriter::create(const tables::PartTables& part, const FeedFacts& facts, 
   h.force_ring_offset = layout.force_ring_offset;
   h.figures_offset = layout.figures_offset;
   h.stock_offset = layout.stock_offset;
+  h.machine_offset = layout.machine_offset;
   auto* mesh = reinterpret_cast<float*>(base_ + layout.mesh_offset);
   for (std::uint32_t t = 0; t < triangles; ++t) {
     for (int v = 0; v < 3; ++v) {
@@ -106,6 +110,7 @@ bool FeedWriter::create(const tables::PartTables& part, const FeedFacts& facts, 
   forces_ = new (base_ + layout.force_ring_offset) ForceRing{};
   figures_ = new (base_ + layout.figures_offset) FiguresCell{};
   stock_ = new (base_ + layout.stock_offset) StockCell{};
+  machine_ = new (base_ + layout.machine_offset) MachineCell{};
   // No display may write it or change its size: only new writable mappings are refused (ours stays);
   // F_SEAL_FUTURE_WRITE needs Linux 5.1, without it the display's read-only mapping is the guard.
   if (fcntl(fd_, F_ADD_SEALS, F_SEAL_SHRINK | F_SEAL_GROW | F_SEAL_FUTURE_WRITE) != 0 &&
@@ -181,7 +186,7 @@ bool FeedView::open_memory(const unsigned char* base, std::size_t size, std::str
     return false;
   }
   if (h.header_bytes != sizeof(FeedHeader) || h.figures_bytes != sizeof(Figures) || h.stock_bytes != sizeof(FeedStock) ||
-      h.telemetry_bytes != sizeof(control::Telemetry)) {
+      h.telemetry_bytes != sizeof(control::Telemetry) || h.machine_bytes != sizeof(FeedMachine)) {
     error = "the controller's state feed was built with another layout of the same version (rebuild both from one tree)";
     return false;
   }
@@ -189,7 +194,7 @@ bool FeedView::open_memory(const unsigned char* base, std::size_t size, std::str
   if (h.total_bytes != size || layout.total_bytes != size || h.mesh_offset != layout.mesh_offset ||
       h.flags_offset != layout.flags_offset || h.touched_offset != layout.touched_offset ||
       h.force_ring_offset != layout.force_ring_offset || h.figures_offset != layout.figures_offset ||
-      h.stock_offset != layout.stock_offset) {
+      h.stock_offset != layout.stock_offset || h.machine_offset != layout.machine_offset) {
     error = "the controller's state feed's regions do not match its triangle count of " + std::to_string(h.triangle_count);
     return false;
   }
@@ -198,6 +203,7 @@ bool FeedView::open_memory(const unsigned char* base, std::size_t size, std::str
   header_ = &h;
   figures_ = reinterpret_cast<const FiguresCell*>(base + h.figures_offset);
   stock_ = reinterpret_cast<const StockCell*>(base + h.stock_offset);
+  machine_ = reinterpret_cast<const MachineCell*>(base + h.machine_offset);
   forces_ = reinterpret_cast<const ForceRing*>(base + h.force_ring_offset);
   touched_ = base + h.touched_offset;
   return true;

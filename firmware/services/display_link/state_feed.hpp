@@ -38,6 +38,7 @@ class FeedWriter {
   void record_force(std::uint64_t cycle, float force_n);
   // The one machine thread.
   void publish(const FeedStock& stock) { stock_->write(stock); }
+  void publish(const FeedMachine& machine) { machine_->write(machine); }
 
   [[nodiscard]] const FeedHeader& header() const { return *header_; }
 
@@ -48,6 +49,7 @@ class FeedWriter {
   FeedHeader* header_ = nullptr;
   FiguresCell* figures_ = nullptr;
   StockCell* stock_ = nullptr;
+  MachineCell* machine_ = nullptr;
   ForceRing* forces_ = nullptr;
   unsigned char* touched_ = nullptr;
 };
@@ -71,6 +73,7 @@ class FeedView {
   [[nodiscard]] const FeedHeader& header() const { return *header_; }
   [[nodiscard]] bool read(Figures& figures) const { return figures_->read(figures); }
   [[nodiscard]] bool read(FeedStock& stock) const { return stock_->read(stock); }
+  [[nodiscard]] bool read(FeedMachine& machine) const { return machine_->read(machine); }
   [[nodiscard]] std::uint64_t stock_sequence() const { return stock_->sequence(); }
   // The set as bits, one a triangle (triangle_count bits, rounded up to bytes).
   void touched(std::vector<std::uint8_t>& bits) const;
@@ -87,6 +90,7 @@ class FeedView {
   const FeedHeader* header_ = nullptr;
   const FiguresCell* figures_ = nullptr;
   const StockCell* stock_ = nullptr;
+  const MachineCell* machine_ = nullptr;
   const ForceRing* forces_ = nullptr;
   const unsigned char* touched_ = nullptr;
 };

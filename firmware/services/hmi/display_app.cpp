@@ -10,6 +10,38 @@ namespace {
 
 constexpr std::size_t kMaxPending = 64;  // requests the controller has not answered yet
 
+const char* request_name(RequestKind kind) {
+  switch (kind) {
+    case RequestKind::Set:
+      return "set";
+    case RequestKind::Reset:
+      return "reset";
+    case RequestKind::Stop:
+      return "stop";
+    case RequestKind::Pause:
+      return "pause";
+    case RequestKind::Resume:
+      return "resume";
+  }
+  return "unknown";
+}
+
+display_link::Message message_of(const Request& request, std::uint32_t id) {
+  switch (request.kind) {
+    case RequestKind::Set:
+      return display_link::make_set(request.parameter, request.value, id);
+    case RequestKind::Reset:
+      return display_link::make_message(display_link::MessageKind::Reset, id);
+    case RequestKind::Stop:
+      return display_link::make_message(display_link::MessageKind::Stop, id);
+    case RequestKind::Pause:
+      return display_link::make_message(display_link::MessageKind::Pause, id);
+    case RequestKind::Resume:
+      return display_link::make_message(display_link::MessageKind::Resume, id);
+  }
+  return display_link::make_message(display_link::MessageKind::Stop, id);
+}
+
 std::string text_of(const nlohmann::json& value) {
   return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
@@ -17,7 +49,7 @@ std::string text_of(const nlohmann::json& value) {
 nlohmann::json reply(const char* type, const Request* request, const std::string& detail) {
   nlohmann::json out{{"type", type}};
   if (request != nullptr) {
-    out["request"] = request->kind == RequestKind::Reset ? "reset" : "set";
+    out["request"] = request_name(request->kind);
     if (request->kind == RequestKind::Set) {
       out["name"] = control::parameter_name(command_kind(request->parameter));
       out["value"] = request->value;
@@ -99,17 +131,17 @@ std::string DisplayApp::handle_message(ClientId client, bool may_control, std::s
     refused = "no controller to take it: " + client_.detail();
   } else if (request.kind == RequestKind::Set) {
     refused = refusal(request, state_.limits());
-  } else {
+  } else if (request.kind == RequestKind::Reset) {
     refused = state_.reset_refusal();
+  } else if (request.kind != RequestKind::Stop) {  // a stop always goes: the controller decides
+    refused = state_.pause_refusal(request.kind);
   }
   if (refused.empty() && pending_.size() >= kMaxPending) {
     refused = "too many requests waiting for the controller; try again";
   }
   if (refused.empty()) {
     const std::uint32_t id = next_id_++;
-    const display_link::Message message =
-        request.kind == RequestKind::Set ? display_link::make_set(request.parameter, request.value, id)
-                                         : display_link::make_message(display_link::MessageKind::Reset, id);
+    const display_link::Message message = message_of(request, id);
     if (client_.send(message)) {
       pending_[id] = Pending{client, request};
       const std::lock_guard<std::mutex> lock(counters_mutex_);

@@ -12,6 +12,35 @@ namespace {
 
 double rounded(double value, double step) { return std::isfinite(value) ? std::round(value / step) * step : 0.0; }
 
+// The event list, oldest first: the commands the cycle took and the safe states it entered.
+nlohmann::json events_json(const display_link::Figures& f) {
+  nlohmann::json list = nlohmann::json::array();
+  const std::uint64_t total = f.events_total;
+  const std::uint64_t first = total > display_link::kFeedEvents ? total - display_link::kFeedEvents : 0;
+  for (std::uint64_t n = first; n < total; ++n) {
+    const display_link::FeedEvent& e = f.events[n % display_link::kFeedEvents];
+    nlohmann::json item = {{"n", n},
+                           {"cycle", e.cycle},
+                           {"t", rounded(static_cast<double>(e.time_ns - f.first_time_ns) / 1e9, 1e-3)},
+                           {"source", control::command_source_name(e.source)}};
+    if (e.type == display_link::FeedEventType::SafeState) {
+      item["type"] = "safe_state";
+      item["reason"] = control::safe_reason_name(e.reason);
+    } else {
+      item["type"] = control::command_kind_name(e.kind);
+      item["outcome"] = control::command_outcome_name(e.outcome);
+      const char* parameter = control::parameter_name(e.kind);
+      if (parameter[0] != 'n') {
+        item["parameter"] = parameter;
+        item["asked"] = std::isfinite(e.asked) ? nlohmann::json(e.asked) : nlohmann::json(nullptr);
+        item["applied"] = std::isfinite(e.applied) ? nlohmann::json(e.applied) : nlohmann::json(nullptr);
+      }
+    }
+    list.push_back(std::move(item));
+  }
+  return list;
+}
+
 nlohmann::json point(const double (&p)[3]) {
   return nlohmann::json::array({rounded(p[0], 1e-4), rounded(p[1], 1e-4), rounded(p[2], 1e-4)});
 }
@@ -84,6 +113,10 @@ void LiveState::update(const display_link::FeedView* feed, std::uint64_t feed_ge
   if (feed->read(now)) {
     figures_ = now;
   }
+  display_link::FeedMachine machine{};
+  if (feed->read(machine)) {
+    machine_ = machine;
+  }
   feed->touched(touched_bits_);
   for (std::size_t byte = 0; byte < touched_bits_.size(); ++byte) {
     const auto added = static_cast<std::uint8_t>(touched_bits_[byte] & ~touched_sent_[byte]);
@@ -125,6 +158,16 @@ std::string LiveState::reset_refusal() const {
     return "the job has ended";
   }
   return display_link::reset_refusal(figures_.have_telemetry != 0, figures_.telemetry, reset_rule_);
+}
+
+std::string LiveState::pause_refusal(display_link::RequestKind kind) const {
+  if (!attached_) {
+    return "no controller";
+  }
+  if (figures_.phase == display_link::JobPhase::Ended) {
+    return "the job has ended";
+  }
+  return display_link::pause_refusal(kind, figures_.have_telemetry != 0, figures_.telemetry);
 }
 
 nlohmann::json LiveState::stock_grid(const display_link::StockGridHeader& g, const std::vector<float>& heights) {
@@ -172,6 +215,18 @@ void LiveState::common(nlohmann::json& out) const {
                    {"requests", telemetry.parameter_requests},
                    {"last", control::parameter_name(telemetry.last_parameter)},
                    {"last_outcome", control::parameter_outcome_name(telemetry.last_parameter_outcome)}};
+  out["safe"]["source"] = control::command_source_name(telemetry.safe_source);
+  out["paused"] = telemetry.paused;
+  // The position readout: device space; the virtual tool and the mill's last target in work (the
+  // part's) and machine (from home) coordinates.
+  out["dro"] = {{"device", point(f.device_mm)},
+                {"tool_work", point(f.virtual_tip_mm)},
+                {"tool_machine", point(f.virtual_machine_mm)},
+                {"mill_work", point(machine_.work_mm)},
+                {"mill_machine", point(machine_.machine_mm)},
+                {"mill_held", machine_.held != 0},
+                {"mill_updates", machine_.updates}};
+  out["events"] = events_json(f);
   const display_link::RequestCounters& r = f.requests;
   out["link"] = {{"displays", r.displays_connected}, {"accepted", r.accepted}, {"refused", r.refused},
                  {"rate_limited", r.rate_limited},  {"malformed", r.malformed}, {"peers_refused", r.peers_refused}};

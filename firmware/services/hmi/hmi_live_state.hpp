@@ -38,6 +38,8 @@ class LiveState {
   // Why a reset may not be asked now ("" when it may): the display's decision; the controller and
   // then the cycle check again.
   [[nodiscard]] std::string reset_refusal() const;
+  // Why a pause or a resume may not be asked now ("" when it may).
+  [[nodiscard]] std::string pause_refusal(display_link::RequestKind kind) const;
   [[nodiscard]] const display_link::RequestLimits& limits() const { return limits_; }
 
   [[nodiscard]] double coverage() const;
@@ -71,6 +73,7 @@ class LiveState {
   std::uint64_t force_cycle_ = 0;                          // the newest cycle the peak has seen
   std::uint64_t stock_sequence_ = 0;
   display_link::StockGridHeader grid_{}, grid_sent_{};
+  display_link::FeedMachine machine_{};
   std::vector<float> heights_, heights_sent_;
   std::uint64_t frames_ = 0;
 };

@@ -13,20 +13,29 @@ bool parse_request(std::string_view text, Request& request, std::string& error) 
   }
   const nlohmann::json message = nlohmann::json::parse(text, nullptr, false);
   if (message.is_discarded()) {
-    error = "not JSON: expected {\"type\":\"set\"|\"reset\", ...}";
+    error = "not JSON: expected {\"type\":\"set\"|\"reset\"|\"stop\"|\"pause\"|\"resume\", ...}";
     return false;
   }
   if (!message.is_object() || !message.contains("type") || !message["type"].is_string()) {
-    error = "expected an object with a string \"type\" (\"set\" or \"reset\")";
+    error = "expected an object with a string \"type\" (\"set\", \"reset\", \"stop\", \"pause\" or \"resume\")";
     return false;
   }
   const std::string type = message["type"].get<std::string>();
-  if (type == "reset") {
-    request = Request{RequestKind::Reset, Parameter::Coupling, 0.0};
-    return true;
+  const struct {
+    const char* name;
+    RequestKind kind;
+  } plain[] = {{"reset", RequestKind::Reset},
+               {"stop", RequestKind::Stop},
+               {"pause", RequestKind::Pause},
+               {"resume", RequestKind::Resume}};
+  for (const auto& known : plain) {
+    if (type == known.name) {
+      request = Request{known.kind, Parameter::Coupling, 0.0};
+      return true;
+    }
   }
   if (type != "set") {
-    error = "unknown \"type\" '" + type.substr(0, 40) + "': expected \"set\" or \"reset\"";
+    error = "unknown \"type\" '" + type.substr(0, 40) + "': expected \"set\", \"reset\", \"stop\", \"pause\" or \"resume\"";
     return false;
   }
   if (!message.contains("name") || !message["name"].is_string()) {

@@ -129,4 +129,15 @@ inline void encode_machine_command(const control::MachineCommandRecord& r, ByteW
   }
 }
 
+inline void encode_command(const control::CommandEvent& e, ByteWriter& out) {
+  out.u64(e.cycle);
+  out.i64(e.time_ns);
+  out.u64(e.queued_after_cycle);
+  out.u8(static_cast<std::uint8_t>(e.kind));
+  out.u8(static_cast<std::uint8_t>(e.source));
+  out.u8(static_cast<std::uint8_t>(e.outcome));
+  out.f64(e.asked);
+  out.f64(e.applied);
+}
+
 }  // namespace stencil::journal

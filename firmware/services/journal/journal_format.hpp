@@ -1,7 +1,7 @@
 // The journal's bytes: what a job recorded, append-only, so that a crash loses at most the records
 // not yet synced and never misreads a torn one.
 //
-// File: the magic "STENCILJ", a u32 version (2), then records. All numbers little-endian.
+// File: the magic "STENCILJ", a u32 version (3; 2 is read too), then records. All numbers little-endian.
 // Record: u32 payload length, u8 type, the payload, u32 CRC-32 (zlib's) of the length, type and
 // payload bytes. A reader stops at the first record that is incomplete or fails its CRC: that and
 // everything after it is the torn tail of a crash, reported and ignored.
@@ -13,7 +13,8 @@
 namespace stencil::journal {
 
 inline constexpr char kMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L', 'J'};
-inline constexpr std::uint32_t kVersion = 2;
+inline constexpr std::uint32_t kVersion = 3;
+inline constexpr std::uint32_t kOldestVersion = 2;  // no Command records, a SafeState without its source
 inline constexpr std::size_t kFileHeaderBytes = 12;
 inline constexpr std::size_t kRecordOverheadBytes = 9;  // length, type, CRC
 // No record is longer; a length over this is a torn or damaged record, not a reason to allocate.
@@ -28,6 +29,7 @@ enum class RecordType : std::uint8_t {
                        // thread, and sent only once written (a crash cannot lose one that was sent)
   Resume = 6,     // a resumed job's next segment starts here (its cycles count from 0 again)
   End = 7,        // the run ended in order (a run without one was killed or crashed)
+  Command = 8,    // a command the cycle took (a stop, a reset, a pause, a parameter): before its cycle's record
 };
 
 // Payload of Start: u32 tables' CRC-32, u32 triangle count, i64 start (ns since the Unix epoch),
@@ -38,8 +40,15 @@ enum class RecordType : std::uint8_t {
 // f32 force_n[3], u16 status_bits, u8 read_status (hal::ReadStatus), u8 read_reason (hal::HapticFault).
 inline constexpr std::uint32_t kCyclePayloadBytes = 8 + 8 + 24 + 16 + 4 + 1 + 24 + 1 + 4 + 12 + 2 + 1 + 1;
 static_assert(kCyclePayloadBytes == 106, "the Cycle payload the comment above lays out");
-// Payload of SafeState: u64 cycle, u8 reason (control::SafeReason).
-inline constexpr std::uint32_t kSafeStatePayloadBytes = 9;
+// Payload of SafeState: u64 cycle, u8 reason (control::SafeReason), u8 source (control::CommandSource:
+// where a stop came from; version 2 has no source).
+inline constexpr std::uint32_t kSafeStatePayloadBytes = 10;
+inline constexpr std::uint32_t kSafeStateV2PayloadBytes = 9;
+// Payload of Command (43 bytes): u64 cycle (that took it), i64 time_ns, u64 queued_after_cycle, u8 kind
+// (control::CommandKind), u8 source (control::CommandSource), u8 outcome (control::CommandOutcome),
+// f64 asked, f64 applied (a parameter's value asked and in force after, its command's unit; else 0).
+inline constexpr std::uint32_t kCommandPayloadBytes = 8 + 8 + 8 + 1 + 1 + 1 + 8 + 8;
+static_assert(kCommandPayloadBytes == 43, "the Command payload the comment above lays out");
 // Payload of Homed: i64 time_ns (the machine's clock).
 inline constexpr std::uint32_t kHomedPayloadBytes = 8;
 // Payload of MachineCommand (55 bytes): u64 update, i64 time_ns, i32 motor_target[3], u8 order[3]

@@ -34,8 +34,9 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
   }
   header.skip(sizeof kMagic);
   const std::uint32_t version = header.u32();
-  if (version != kVersion) {
-    result.error = at(8) + "version " + std::to_string(version) + "; this program reads version " + std::to_string(kVersion);
+  if (version < kOldestVersion || version > kVersion) {
+    result.error = at(8) + "version " + std::to_string(version) + "; this program reads versions " +
+                   std::to_string(kOldestVersion) + " to " + std::to_string(kVersion);
     return result;
   }
   std::size_t offset = kFileHeaderBytes;
@@ -144,9 +145,10 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         break;
       }
       case RecordType::SafeState: {
-        if (length != kSafeStatePayloadBytes) {
+        const std::uint32_t expected = version == kOldestVersion ? kSafeStateV2PayloadBytes : kSafeStatePayloadBytes;
+        if (length != expected) {
           result.error = at(offset) + "a safe-state record of " + std::to_string(length) + " bytes (expected " +
-                         std::to_string(kSafeStatePayloadBytes) + ")";
+                         std::to_string(expected) + ")";
           return result;
         }
         const std::uint64_t cycle = body.u64();
@@ -155,8 +157,49 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
           result.error = at(offset) + "a safe-state record's reason is " + std::to_string(reason) + " (no such reason)";
           return result;
         }
+        const std::uint8_t source = version == kOldestVersion ? 0 : body.u8();
+        if (source >= control::kCommandSourceCount) {
+          result.error = at(offset) + "a safe-state record's source is " + std::to_string(source) + " (no such source)";
+          return result;
+        }
         if (visit.safe_state) {
           visit.safe_state(cycle, static_cast<control::SafeReason>(reason));
+        }
+        if (visit.safe_source) {
+          visit.safe_source(cycle, static_cast<control::SafeReason>(reason), static_cast<control::CommandSource>(source));
+        }
+        break;
+      }
+      case RecordType::Command: {
+        if (version == kOldestVersion || length != kCommandPayloadBytes) {
+          result.error = at(offset) + "a command record of " + std::to_string(length) + " bytes in a version " +
+                         std::to_string(version) + " journal (expected " + std::to_string(kCommandPayloadBytes) +
+                         " bytes, version 3)";
+          return result;
+        }
+        control::CommandEvent e{};
+        e.cycle = body.u64();
+        e.time_ns = body.i64();
+        e.queued_after_cycle = body.u64();
+        const std::uint8_t kind = body.u8();
+        const std::uint8_t source = body.u8();
+        const std::uint8_t outcome = body.u8();
+        e.asked = body.f64();
+        e.applied = body.f64();
+        if (kind >= control::kCommandKindCount || source >= control::kCommandSourceCount ||
+            outcome >= control::kCommandOutcomeCount) {
+          result.error = at(offset) + "a command record's kind, source or outcome is out of range (" +
+                         std::to_string(kind) + ", " + std::to_string(source) + ", " + std::to_string(outcome) +
+                         "; expected below " + std::to_string(control::kCommandKindCount) + ", " +
+                         std::to_string(control::kCommandSourceCount) + ", " +
+                         std::to_string(control::kCommandOutcomeCount) + ")";
+          return result;
+        }
+        e.kind = static_cast<control::CommandKind>(kind);
+        e.source = static_cast<control::CommandSource>(source);
+        e.outcome = static_cast<control::CommandOutcome>(outcome);
+        if (visit.command) {
+          visit.command(e);
         }
         break;
       }

@@ -17,6 +17,9 @@ struct JournalVisitor {
   std::function<void(const JournalStart&)> start;
   std::function<void(const control::JournalRecord&)> cycle;
   std::function<void(std::uint64_t cycle, control::SafeReason)> safe_state;
+  // The same record with where it came from (version 2: CommandSource::Cycle).
+  std::function<void(std::uint64_t cycle, control::SafeReason, control::CommandSource)> safe_source;
+  std::function<void(const control::CommandEvent&)> command;
   std::function<void(std::int64_t time_ns)> homed;
   std::function<void(const control::MachineCommandRecord&)> machine_command;
   std::function<void(const JournalResume&)> resume;

@@ -79,9 +79,20 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
 bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_bytes, const JournalResume& resume) {
   std::unique_lock<std::mutex> lock(mutex_);
   path_ = path;
-  fd_ = ::open(path.c_str(), O_WRONLY | O_CLOEXEC);
+  fd_ = ::open(path.c_str(), O_RDWR | O_CLOEXEC);  // read: its version
   if (fd_ < 0) {
     return fail("cannot be opened to carry on with it", errno);
+  }
+  // Its records would be this version's: a journal an older program began is not carried on.
+  std::uint8_t header[kFileHeaderBytes] = {};
+  if (::pread(fd_, header, sizeof header, 0) != static_cast<ssize_t>(sizeof header)) {
+    return fail("cannot read its header", errno);
+  }
+  ByteReader version_bytes(header + sizeof kMagic, 4);
+  if (const std::uint32_t version = version_bytes.u32(); version != kVersion) {
+    return fail("is a version " + std::to_string(version) + " journal; this program carries on version " +
+                    std::to_string(kVersion) + " journals only (start the job afresh)",
+                0);
   }
   if (::ftruncate(fd_, static_cast<off_t>(good_bytes)) != 0) {
     return fail("cannot be cut to its " + std::to_string(good_bytes) + " whole bytes", errno);
@@ -200,12 +211,25 @@ bool JournalWriter::append(const control::JournalRecord& r) {
     ByteWriter event;
     event.u64(r.cycle);
     event.u8(static_cast<std::uint8_t>(r.safe_reason));
+    event.u8(static_cast<std::uint8_t>(r.safe_source));
     add_record(RecordType::SafeState, event.data(), static_cast<std::uint32_t>(event.size()));
     return sync_locked(lock);  // the event and everything before it are on the disk before anything else
   }
   if (r.safe_reason == control::SafeReason::None) {
     in_safe_state_ = false;  // reset: the next safe state is a new event
   }
+  return buffer_.size() < kWriteOutBytes || write_out();
+}
+
+bool JournalWriter::append_command(const control::CommandEvent& event) {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  if (fd_ < 0 || failed_ || !write_machine_commands_locked()) {
+    return false;
+  }
+  ByteWriter payload;
+  encode_command(event, payload);
+  add_record(RecordType::Command, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  ++command_records_;
   return buffer_.size() < kWriteOutBytes || write_out();
 }
 

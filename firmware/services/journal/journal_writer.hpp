@@ -103,6 +103,10 @@ class JournalWriter {
   // written after that).
   [[nodiscard]] bool append(const control::JournalRecord& record);
 
+  // A command the cycle took, before the record of the cycle that took it (the records thread keeps
+  // that order: journal::JournalDrain). False as for append().
+  [[nodiscard]] bool append_command(const control::CommandEvent& event);
+
   // The run ends in order: its End record, synced (call once, after the last cycle's record).
   [[nodiscard]] bool append_end(std::uint64_t cycles, control::SafeReason reason);
 
@@ -119,6 +123,7 @@ class JournalWriter {
   [[nodiscard]] const std::string& path() const { return path_; }
   [[nodiscard]] std::uint64_t cycle_records() const { return cycle_records_; }
   [[nodiscard]] std::uint64_t machine_records() const { return machine_records_; }
+  [[nodiscard]] std::uint64_t command_records() const { return command_records_; }
   [[nodiscard]] std::uint64_t machine_commands_refused() const { return machine_refused_.load(); }
   [[nodiscard]] std::uint64_t syncs() const { return syncs_; }
   [[nodiscard]] std::uint64_t bytes_written() const { return bytes_written_; }
@@ -154,6 +159,7 @@ class JournalWriter {
   bool synced_once_ = false;
   std::uint64_t cycle_records_ = 0;
   std::uint64_t machine_records_ = 0;
+  std::uint64_t command_records_ = 0;
   std::uint64_t syncs_ = 0;
   std::uint64_t bytes_written_ = 0;
 };

@@ -1,5 +1,7 @@
 #include "firmware/services/report/job_report.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 namespace stencil::report {
@@ -53,6 +55,66 @@ void merge_into(nlohmann::json& into, const nlohmann::json& from) {
   }
 }
 
+nlohmann::json xyz(const double (&v)[3]) { return nlohmann::json::array({v[0], v[1], v[2]}); }
+
+// Infinity has no JSON: an unlimited speed is null.
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json limits_json(std::uint64_t from_cycle, double from_s, const OperatorLimits& limits) {
+  return {{"from_cycle", from_cycle},
+          {"from_s", from_s},
+          {"coupling_n_per_device_mm", limits.coupling_n_per_device_mm},
+          {"force_limit_n", limits.force_limit_n},
+          {"speed_limit_mm_per_s", finite_or_null(limits.speed_limit_mm_per_s)}};
+}
+
+// The commands in order, the limits in force from each change on, the pauses and the positions.
+nlohmann::json operator_json(const OperatorRecord& r, control::SafeReason safe_state, nlohmann::json& limits_out,
+                             nlohmann::json& positions_out) {
+  nlohmann::json list = nlohmann::json::array();
+  nlohmann::json limits = nlohmann::json::array({limits_json(0, 0.0, r.initial_limits)});
+  OperatorLimits now = r.initial_limits;
+  std::uint64_t pauses = 0;
+  for (const control::CommandEvent& e : r.commands) {
+    const double t_s = static_cast<double>(e.time_ns - r.start_ns) / 1e9;
+    nlohmann::json item = {{"cycle", e.cycle},
+                           {"t_s", t_s},
+                           {"kind", control::command_kind_name(e.kind)},
+                           {"source", control::command_source_name(e.source)},
+                           {"outcome", control::command_outcome_name(e.outcome)},
+                           {"waited_cycles", e.cycle - std::min(e.cycle, e.queued_after_cycle)}};
+    const char* parameter = control::parameter_name(e.kind);
+    const bool set = parameter[0] != 'n';
+    if (set) {
+      item["parameter"] = parameter;
+      item["asked"] = finite_or_null(e.asked);
+      item["applied"] = finite_or_null(e.applied);
+    }
+    list.push_back(item);
+    pauses += e.kind == control::CommandKind::Pause && e.outcome == control::CommandOutcome::Done ? 1 : 0;
+    if (set && e.outcome != control::CommandOutcome::Refused) {
+      (e.kind == control::CommandKind::SetCoupling     ? now.coupling_n_per_device_mm
+       : e.kind == control::CommandKind::SetForceLimit ? now.force_limit_n
+                                                       : now.speed_limit_mm_per_s) = e.applied;
+      limits.push_back(limits_json(e.cycle, t_s, now));
+    }
+  }
+  limits_out = limits;
+  const FinalPositions& p = r.positions;
+  positions_out = {{"device_mm", xyz(p.device_mm)},
+                   {"virtual_tool", {{"work_mm", xyz(p.virtual_work_mm)}, {"machine_mm", xyz(p.virtual_machine_mm)}}},
+                   {"mill_commanded", {{"work_mm", xyz(p.mill_work_mm)}, {"machine_mm", xyz(p.mill_machine_mm)}}}};
+  return {{"count", r.commands.size() + r.commands_unlisted},
+          {"unlisted", r.commands_unlisted},
+          {"pauses", pauses},
+          {"machine_holds", r.machine_holds},
+          {"machine_held_updates", r.machine_held_updates},
+          {"safe_state_source", safe_state == control::SafeReason::None
+                                    ? nlohmann::json(nullptr)
+                                    : nlohmann::json(control::command_source_name(r.safe_source))},
+          {"list", list}};
+}
+
 }  // namespace
 
 Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
@@ -77,6 +139,11 @@ bool write_job_report(const std::string& path, const JobFigures& f, const nlohma
       {"safe_state", f.safe_state == control::SafeReason::None ? nlohmann::json(nullptr)
                                                                 : nlohmann::json(control::safe_reason_name(f.safe_state))},
   };
+  nlohmann::json limits;
+  nlohmann::json positions;
+  report["commands"] = operator_json(f.operator_record, f.safe_state, limits, positions);
+  report["limits"] = limits;
+  report["final_positions"] = positions;
   if (board_sections.is_object()) {
     merge_into(report, board_sections);
   }

@@ -6,9 +6,11 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
+#include "firmware/core/control/cycle_messages.hpp"
 #include "firmware/core/control/loop_statistics.hpp"
 #include "firmware/core/control/safe_state.hpp"
 #include "firmware/services/journal/job_history.hpp"
@@ -21,6 +23,36 @@ struct Quantiles {
 
 // p50, p99, p99.9 and the most of a histogram, in microseconds.
 [[nodiscard]] Quantiles quantiles_of(const control::MicrosecondHistogram& histogram);
+
+// The operator's parameters as they stood (the same units as the commands that set them).
+struct OperatorLimits {
+  double coupling_n_per_device_mm = 0.0;
+  double force_limit_n = 0.0;
+  double speed_limit_mm_per_s = 0.0;  // infinity: unlimited
+};
+
+// Where everything stood when the run ended: a machine's position readout, in millimetres.
+struct FinalPositions {
+  double device_mm[3] = {0, 0, 0};           // the device's tip, device space
+  double virtual_work_mm[3] = {0, 0, 0};     // the virtual tool's tip, the part's (work) coordinates
+  double virtual_machine_mm[3] = {0, 0, 0};  // the same in machine coordinates (from home)
+  double mill_work_mm[3] = {0, 0, 0};        // the last target sent to the mill, work coordinates
+  double mill_machine_mm[3] = {0, 0, 0};     // the same in machine coordinates
+};
+
+// What the operator did and what came of it: every command the cycle took, in order, the limits
+// in force at the start, the feed holds, where a safe state came from and where everything ended.
+struct OperatorRecord {
+  std::vector<control::CommandEvent> commands;  // the first journal::JournalDrain::kMaxListed
+  std::uint64_t commands_unlisted = 0;
+  OperatorLimits initial_limits;
+  std::int64_t start_ns = 0;  // the run's first cycle's deadline: a command's time counts from here
+  double period_s = 1e-3;
+  std::uint64_t machine_holds = 0;       // feed holds the machine side took to the link
+  std::uint64_t machine_held_updates = 0;
+  control::CommandSource safe_source = control::CommandSource::Cycle;
+  FinalPositions positions;
+};
 
 struct JobFigures {
   std::uint64_t cycles = 0;
@@ -40,6 +72,7 @@ struct JobFigures {
   // touched set rebuilt from it.
   journal::JobHistory earlier;
   std::uint32_t touched_rebuilt = 0;
+  OperatorRecord operator_record;
 };
 
 // The report: the figures as JSON, with `board_sections` merged in (an object; its keys add to the
