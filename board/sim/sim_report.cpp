@@ -69,6 +69,8 @@ nlohmann::json simulation_sections(const SimResult& r) {
       {"coverage_fraction", r.coverage_fraction},
       {"complete", r.complete},
       {"machine", {{"take_ups", r.machine_take_ups},
+                   {"safe_state_s", r.safe_state_s >= 0.0 ? nlohmann::json(r.safe_state_s) : nlohmann::json(nullptr)},
+                   {"stopped_s", r.machine_stopped_s >= 0.0 ? nlohmann::json(r.machine_stopped_s) : nlohmann::json(nullptr)},
                    {"spindle_on_after_stop", r.mill_spindle_on_after_stop},
                    {"drivers_on_after_stop", r.mill_drivers_on_after_stop},
                    {"watchdog_relay_dropped_power", r.mill_relay_dropped_power},

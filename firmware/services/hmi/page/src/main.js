@@ -4,6 +4,7 @@
 import { connect } from './connection.js';
 import { Scene } from './scene.js';
 import { drawHistogram, ForcePlot } from './plots.js';
+import { clearEvents, showEvents, showReadout } from './readout.js';
 
 const $ = (id) => document.getElementById(id);
 const scene = new Scene($('view'));
@@ -39,6 +40,7 @@ function showController(controller) {
   }
   document.body.dataset.controller = controller.ended ? 'ended' : controller.state;
   if (controller.job && controller.job !== '0' && controller.job !== partJob && !partLoading) {
+    clearEvents();
     loadPart(controller.job);
   }
 }
@@ -68,6 +70,22 @@ function showState(message) {
   const state = $('safe');
   state.textContent = safe.active ? `SAFE STATE: ${safe.reason}` : 'cutting';
   state.className = safe.active ? 'state-bad' : 'state-ok';
+  if (safe.active) {
+    state.textContent += ` (from ${safe.source})`;
+  } else if (message.paused) {
+    state.textContent = 'PAUSED: the tool and the mill are held';
+    state.className = 'state-warn';
+  }
+  const live = mayControl && message.controller && message.controller.state === 'connected' && !message.controller.ended;
+  $('stop').disabled = !live;
+  const pause = $('pause');
+  pause.textContent = message.paused ? 'Resume' : 'Pause';
+  pause.dataset.request = message.paused ? 'resume' : 'pause';
+  pause.disabled = !(live && !safe.active);
+  document.body.dataset.paused = String(Boolean(message.paused));
+  document.body.dataset.safe = safe.active ? safe.reason : 'none';
+  showReadout(message.dro);
+  showEvents(message.events);
   const reset = $('reset');
   reset.disabled = !(mayControl && safe.active && safe.reset_allowed);
   $('reset-reason').textContent = safe.active
@@ -136,14 +154,18 @@ function onMessage(message) {
       document.body.dataset.coverage = String(message.coverage);
       document.body.dataset.t = String(message.t);
       break;
-    case 'accepted':
-      $('param-message').textContent = `${message.name ?? message.request}: sent to the cycle`;
-      $('param-message').className = 'note state-ok';
+    case 'accepted': {
+      const where = message.request === 'set' ? $('param-message') : $('machine-message');
+      where.textContent = `${message.name ?? message.request}: sent to the cycle`;
+      where.className = 'note state-ok';
       break;
-    case 'refused':
-      $('param-message').textContent = `refused: ${message.reason}`;
-      $('param-message').className = 'note state-bad';
+    }
+    case 'refused': {
+      const where = message.request === 'set' || !message.request ? $('param-message') : $('machine-message');
+      where.textContent = `${message.request ?? 'request'} refused: ${message.reason}`;
+      where.className = 'note state-bad';
       break;
+    }
     case 'error':
       $('param-message').textContent = `error: ${message.error}`;
       $('param-message').className = 'note state-bad';
@@ -171,6 +193,8 @@ for (const input of document.querySelectorAll('#params input')) {
   input.addEventListener('input', () => { input.dataset.edited = '1'; });
 }
 $('reset').addEventListener('click', () => link.send({ type: 'reset' }));
+$('stop').addEventListener('click', () => link.send({ type: 'stop' }));
+$('pause').addEventListener('click', () => link.send({ type: $('pause').dataset.request || 'pause' }));
 
 
 // For the end-to-end test and for anyone curious: how much of the view is not background.
