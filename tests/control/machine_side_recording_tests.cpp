@@ -58,6 +58,7 @@ struct Bench {
   hal::MonotonicNs now = 0;
   std::uint64_t cycle = 0;
   double x_mm = 25.0;
+  bool paused = false;  // the cycle's feed hold, in every handoff
 
   Bench() {
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
@@ -68,8 +69,8 @@ struct Bench {
   // One machine update's worth of cycles: the virtual tool moves +x at 1 mm/s, then the update.
   void update() {
     for (int i = 0; i < 33; ++i) {
-      x_mm += 1e-3;
-      CHECK(handoffs.push({++cycle, {x_mm, 12.5, 20.0}, false, false}));
+      x_mm += paused ? 0.0 : 1e-3;  // paused, the virtual tool stays
+      CHECK(handoffs.push({++cycle, {x_mm, 12.5, 20.0}, false, paused}));
     }
     now += kUpdateNs;
     machine->update(now + 2 * kUpdateNs);
@@ -186,4 +187,38 @@ TEST(MachineSideRecording, AfterAHeldTargetGoesTheNextWaitsForTheNextUpdateEvenI
     LONGS_EQUAL(3 + i, bench.recorder.queued.size());
   }
   CHECK(bench.machine->state() == control::MachineSideState::Cutting);
+}
+
+// Issue 22: the operator's Pause holds the feed at the link at the next update; nothing is planned,
+// recorded or sent while it lasts (the heartbeat goes on), and Resume carries on with no homing.
+TEST(MachineSideRecording, APauseHoldsTheFeedAndSendsNothingUntilTheResume) {
+  Bench bench;
+  bench.recorder.write_at_once = true;
+  for (int i = 0; i < 5; ++i) {
+    bench.update();
+  }
+  const std::size_t moves = bench.link.moves().size();
+  const std::size_t records = bench.recorder.queued.size();
+  CHECK(moves > 0);
+  bench.paused = true;
+  for (int i = 0; i < 6; ++i) {
+    bench.update();
+    CHECK(bench.link.status().state == hal::MachineState::Held);
+    CHECK(bench.machine->held());
+  }
+  LONGS_EQUAL(moves, bench.link.moves().size());
+  LONGS_EQUAL(records, bench.recorder.queued.size());
+  LONGS_EQUAL(0, bench.link.refused_while_held());
+  LONGS_EQUAL(1, bench.machine->statistics().holds);
+  LONGS_EQUAL(6, bench.machine->statistics().held_updates);
+  CHECK(bench.machine->state() == control::MachineSideState::Cutting);  // held, not stopped
+  bench.paused = false;
+  for (int i = 0; i < 5; ++i) {
+    bench.update();
+  }
+  CHECK(bench.link.status().state == hal::MachineState::Homed);
+  CHECK_FALSE(bench.machine->held());
+  CHECK(bench.link.moves().size() > moves);
+  LONGS_EQUAL(0, bench.link.refused_while_held());
+  LONGS_EQUAL(0, bench.link.stops());
 }

@@ -191,3 +191,54 @@ TEST(DisplayLink, WhenTheControllerEndsTheDisplayKeepsItsLastStateAndSaysHow) {
   CHECK_EQUAL(2U, client.feed_generation());
   STRCMP_EQUAL("stencil-next", client.feed()->header().program);
 }
+
+// Issue 22: the feed carries the event list (each command taken, each safe state with its source)
+// and the position readout (the record's device and tool, the machine thread's mill).
+TEST(DisplayLink, TheFeedCarriesTheEventsAndThePositionsTheReadoutShows) {
+  Prism prism;
+  Folder folder;
+  DisplayLink link(prism.part, config(), {folder.socket(), "stencil-test", false});
+  std::string error;
+  CHECK_TRUE_TEXT(link.start(error), error.c_str());
+  ControllerClient client(folder.socket());
+  poll_until(client, [&](const auto&) { return client.feed() != nullptr; });
+  const FeedView* feed = client.feed();
+  CHECK(feed != nullptr);
+  FeedMachine machine{};
+  CHECK(feed->read(machine));
+  DOUBLES_EQUAL(25.0, machine.work_mm[0], 0.0);  // at home until the first update
+  DOUBLES_EQUAL(0.0, machine.machine_mm[0], 0.0);
+
+  link.on_command({7, 7'000'000, 6, control::CommandKind::SetForceLimit, control::CommandSource::Display,
+                   control::CommandOutcome::Clamped, 50.0, 5.0});
+  control::JournalRecord stopped = record_at(9, Eigen::Vector3d(26.0, 12.0, 19.5), 0);
+  stopped.safe_reason = control::SafeReason::Stopped;
+  stopped.safe_source = control::CommandSource::Signal;
+  link.on_record(stopped);
+  link.on_record(record_at(10, Eigen::Vector3d(26.0, 12.0, 19.5), 0));  // reset: no event of its own
+  const control::StockBlock block{{20.0, 8.0, 0.0}, {30.0, 16.0, 7.0}};
+  std::vector<float> cells(control::CommandedStock::cells_needed(block, 0.5));
+  const control::CommandedStock model(block, 0.5, prism.part.tool.spec, cells);
+  link.on_machine({0.01, {25.5, 12.25, 19.75}, true}, model);
+  link.end("test");
+  Figures figures{};
+  CHECK(feed->read(figures));
+  CHECK_EQUAL(2U, figures.events_total);
+  CHECK(figures.events[0].type == FeedEventType::Command);
+  CHECK(figures.events[0].kind == control::CommandKind::SetForceLimit);
+  CHECK(figures.events[0].outcome == control::CommandOutcome::Clamped);
+  DOUBLES_EQUAL(5.0, figures.events[0].applied, 0.0);
+  CHECK(figures.events[1].type == FeedEventType::SafeState);
+  CHECK(figures.events[1].reason == control::SafeReason::Stopped);
+  CHECK(figures.events[1].source == control::CommandSource::Signal);
+  LONGS_EQUAL(9, figures.events[1].cycle);
+  DOUBLES_EQUAL(260.0, figures.device_mm[0], 1e-12);
+  DOUBLES_EQUAL(-1.0, figures.virtual_machine_mm[0], 1e-12);  // x counts against the world's
+  DOUBLES_EQUAL(-0.5, figures.virtual_machine_mm[2], 1e-12);
+  CHECK(feed->read(machine));
+  DOUBLES_EQUAL(25.5, machine.work_mm[0], 0.0);
+  DOUBLES_EQUAL(-0.5, machine.machine_mm[0], 1e-12);
+  DOUBLES_EQUAL(0.25, machine.machine_mm[1], 1e-12);
+  DOUBLES_EQUAL(-0.25, machine.machine_mm[2], 1e-12);
+  CHECK_EQUAL(1U, machine.held);
+}

@@ -91,3 +91,37 @@ TEST(MessageCodec, AnotherVersionIsAMismatchNamingBoth) {
   STRCMP_CONTAINS(("protocol version " + std::to_string(kProtocolVersion + 1)).c_str(), error.c_str());
   STRCMP_CONTAINS(("this side speaks version " + std::to_string(kProtocolVersion)).c_str(), error.c_str());
 }
+
+TEST(MessageCodec, StopPauseAndResumeAreRequestsWithNoParameterAndNoValue) {
+  const MessageKind kinds[] = {MessageKind::Stop, MessageKind::Pause, MessageKind::Resume};
+  const RequestKind requests[] = {RequestKind::Stop, RequestKind::Pause, RequestKind::Resume};
+  const stencil::control::CommandKind commands[] = {stencil::control::CommandKind::Stop,
+                                                    stencil::control::CommandKind::Pause,
+                                                    stencil::control::CommandKind::Resume};
+  for (int i = 0; i < 3; ++i) {
+    Bytes bytes(make_message(kinds[i], 3));
+    Message out{};
+    std::string error;
+    CHECK(DecodeResult::Ok == decode_request(bytes.data, kMessageBytes, out, error));
+    const Request request = request_of(out);
+    CHECK(request.kind == requests[i]);
+    const stencil::control::Command command = command_of(request);
+    CHECK(command.kind == commands[i]);
+    CHECK(command.source == stencil::control::CommandSource::Display);
+    Message bad = make_message(kinds[i], 3);
+    bad.value = 1.0;
+    STRCMP_CONTAINS("byte 16: expected 0 outside a Set", decode_error(bad).c_str());
+  }
+}
+
+TEST(MessageCodec, APauseOrAResumeIsRefusedWhenTheCycleCannotTakeIt) {
+  stencil::control::Telemetry t{};
+  STRCMP_EQUAL("the job has not started yet", pause_refusal(RequestKind::Pause, false, t).c_str());
+  STRCMP_EQUAL("", pause_refusal(RequestKind::Pause, true, t).c_str());
+  STRCMP_EQUAL("not paused", pause_refusal(RequestKind::Resume, true, t).c_str());
+  t.paused = true;
+  STRCMP_EQUAL("already paused", pause_refusal(RequestKind::Pause, true, t).c_str());
+  STRCMP_EQUAL("", pause_refusal(RequestKind::Resume, true, t).c_str());
+  t.safe_reason = stencil::control::SafeReason::Stopped;
+  STRCMP_CONTAINS("in its safe state (stopped)", pause_refusal(RequestKind::Resume, true, t).c_str());
+}

@@ -31,6 +31,10 @@ class SpyMachineLink final : public hal::MachineLink {
   }
   hal::MachineResult declare_home(hal::MonotonicNs deadline_ns) override { return home(deadline_ns); }
   hal::MachineResult move(const hal::MachineTarget& target, hal::MonotonicNs) override {
+    if (status_.state == hal::MachineState::Held) {
+      ++refused_while_held_;  // as the CY545 link: a held feed refuses moves (a MachineSide that sent one is wrong)
+      return {false, hal::MachineRefusal::Held, hal::MachineFault::None};
+    }
     if (on_move) {
       on_move(target);
     }
@@ -54,9 +58,11 @@ class SpyMachineLink final : public hal::MachineLink {
     return done();
   }
   [[nodiscard]] hal::MachineStatus status() const override { return status_; }
+  [[nodiscard]] int refused_while_held() const { return refused_while_held_; }
   [[nodiscard]] std::array<int, 3> home_approach() const override { return {-1, -1, -1}; }
 
  private:
+  int refused_while_held_ = 0;
   static hal::MachineResult done() { return {true, hal::MachineRefusal::None, hal::MachineFault::None}; }
   hal::MachineStatus status_{hal::MachineState::Ready, hal::MachineFault::None, {0, 0, 0}, false, false, true, 0, 0, 0};
   std::vector<hal::MachineTarget> moves_;

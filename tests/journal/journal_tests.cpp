@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <unistd.h>
+#include <zlib.h>
 
 #include "firmware/services/journal/journal_drain.hpp"
 #include "firmware/services/journal/journal_format.hpp"
@@ -404,4 +405,141 @@ TEST(Journal, AMachineCommandThatNamesNoAxisOrAnInfiniteTargetIsAnErrorNamingThe
   CHECK(read.error.find("journal offset ") != std::string::npos);
   CHECK(read.error.find("leg order") != std::string::npos);
   LONGS_EQUAL(0, seen.commands.size());
+}
+
+// Issue 22: each command the cycle took is a record of its own, before the record of its cycle, and
+// the safe state says where it came from.
+TEST(Journal, TheDrainWritesEachCommandBeforeItsCyclesRecordAndTheSafeStateWithItsSource) {
+  using stencil::control::CommandEvent;
+  using stencil::control::CommandKind;
+  using stencil::control::CommandOutcome;
+  using stencil::control::CommandSource;
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  stencil::control::CommandRing commands;
+  stencil::control::JournalRing ring;
+  stencil::control::CommandEventRing taken;
+  JournalDrain drain(&writer, commands);
+  drain.take_commands_from(&taken);
+  // Cycle 3 took a speed change, cycle 5 a pause and a stop (from the display); the drain looks
+  // after cycle 4, when cycle 5's commands are out and its record is not yet.
+  for (std::uint64_t cycle = 1; cycle <= 4; ++cycle) {
+    if (cycle == 3) {
+      CHECK(taken.push(CommandEvent{3, 3'000'017, 2, CommandKind::SetSpeedLimit, CommandSource::Display,
+                                    CommandOutcome::Clamped, 50.0, 1.0}));
+    }
+    CHECK(ring.push(record_of(cycle)));
+  }
+  CHECK(taken.push(CommandEvent{5, 5'000'017, 4, CommandKind::Pause, CommandSource::Display, CommandOutcome::Done, 0.0, 0.0}));
+  CHECK(taken.push(CommandEvent{5, 5'000'017, 4, CommandKind::Stop, CommandSource::Display, CommandOutcome::Done, 0.0, 0.0}));
+  drain.drain(ring);
+  JournalRecord stopped = record_of(5, SafeReason::Stopped);
+  stopped.safe_source = CommandSource::Display;
+  CHECK(ring.push(stopped));
+  drain.drain(ring, true);
+  CHECK_FALSE(drain.failed());
+  LONGS_EQUAL(3, drain.commands().size());
+  CHECK_TRUE(writer.close());
+
+  std::vector<std::string> order;
+  JournalVisitor visit;
+  visit.cycle = [&](const JournalRecord& r) { order.push_back("cycle " + std::to_string(r.cycle)); };
+  visit.command = [&](const CommandEvent& e) {
+    order.push_back(std::string(stencil::control::command_kind_name(e.kind)) + " " + std::to_string(e.cycle));
+  };
+  visit.safe_source = [&](std::uint64_t cycle, SafeReason reason, CommandSource source) {
+    order.push_back(std::string("safe ") + stencil::control::safe_reason_name(reason) + " " + std::to_string(cycle) +
+                    " from " + stencil::control::command_source_name(source));
+  };
+  Seen seen;
+  JournalVisitor values = seen.visitor();
+  CHECK_TRUE(read_journal_file(file.path, visit).ok);
+  CHECK_TRUE(read_journal_file(file.path, values).ok);
+  std::string joined;
+  for (const std::string& item : order) {
+    joined += item + "; ";
+  }
+  STRCMP_EQUAL("cycle 1; cycle 2; set_speed_limit 3; cycle 3; cycle 4; pause 5; stop 5; cycle 5; safe stopped 5 from display; ",
+               joined.c_str());
+  LONGS_EQUAL(3, seen.taken.size());
+  const CommandEvent& speed = seen.taken[0];
+  LONGS_EQUAL(2, speed.queued_after_cycle);
+  CHECK(speed.outcome == CommandOutcome::Clamped);
+  DOUBLES_EQUAL(50.0, speed.asked, 0.0);
+  DOUBLES_EQUAL(1.0, speed.applied, 0.0);
+  CHECK(speed.source == CommandSource::Display);
+  CHECK(speed.time_ns == 3'000'017);
+}
+
+TEST(Journal, AVersion2JournalStillReadsButIsNotCarriedOn) {
+  TempJournal file;
+  write_job(file.path, 20, 10);
+  // The same journal as version 2 wrote it: the version, and a safe-state record without its source.
+  std::vector<std::uint8_t> bytes = file.bytes();
+  std::vector<std::uint8_t> old(bytes.begin(), bytes.begin() + static_cast<long>(kFileHeaderBytes));
+  old[8] = 2;
+  JournalVisitor offsets;
+  std::vector<std::size_t> starts;
+  offsets.offset = [&](std::size_t offset) { starts.push_back(offset); };
+  const JournalReadResult whole = read_journal(bytes.data(), bytes.size(), offsets);
+  CHECK_TRUE(whole.ok);
+  starts.push_back(whole.good_bytes);
+  for (std::size_t i = 0; i + 1 < starts.size(); ++i) {
+    const std::size_t at = starts[i];
+    if (bytes[at + 4] != static_cast<std::uint8_t>(RecordType::SafeState)) {
+      old.insert(old.end(), bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(starts[i + 1]));
+      continue;
+    }
+    std::vector<std::uint8_t> record(bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(at + 5 + 9));
+    record[0] = 9;  // the length: no source byte
+    const uLong crc = crc32(crc32(0L, Z_NULL, 0), record.data(), static_cast<uInt>(record.size()));
+    for (int b = 0; b < 4; ++b) {
+      record.push_back(static_cast<std::uint8_t>(crc >> (8 * b)));
+    }
+    old.insert(old.end(), record.begin(), record.end());
+  }
+  Seen seen;
+  const JournalReadResult read = read_journal(old.data(), old.size(), seen.visitor());
+  CHECK_TEXT(read.ok, read.error.c_str());
+  LONGS_EQUAL(20, seen.cycles.size());
+  LONGS_EQUAL(1, seen.events.size());
+  LONGS_EQUAL(1, seen.sources.size());
+  CHECK(seen.sources[0] == stencil::control::CommandSource::Cycle);
+  // Carrying it on would mix versions in one file: refused, naming both.
+  {
+    std::ofstream out(file.path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(old.data()), static_cast<std::streamsize>(old.size()));
+  }
+  JournalWriter writer;
+  JournalResume resume;
+  resume.segment = 1;
+  CHECK_FALSE(writer.open_to_resume(file.path, read.good_bytes, resume));
+  STRCMP_CONTAINS("is a version 2 journal; this program carries on version 3 journals only", writer.error().c_str());
+}
+
+TEST(Journal, ACommandRecordOutOfRangeIsAnErrorNamingTheOffset) {
+  TempJournal file;
+  JournalWriter writer;
+  CHECK_TRUE(writer.open(file.path, start_of()));
+  CHECK_TRUE(writer.append_command({1, 17, 0, stencil::control::CommandKind::Pause, stencil::control::CommandSource::Display,
+                                    stencil::control::CommandOutcome::Done, 0.0, 0.0}));
+  CHECK_TRUE(writer.close());
+  std::vector<std::uint8_t> bytes = file.bytes();
+  JournalVisitor offsets;
+  std::vector<std::size_t> starts;
+  offsets.offset = [&](std::size_t offset) { starts.push_back(offset); };
+  CHECK_TRUE(read_journal(bytes.data(), bytes.size(), offsets).ok);
+  const std::size_t at = starts.back();
+  LONGS_EQUAL(static_cast<int>(RecordType::Command), bytes[at + 4]);
+  bytes[at + 5 + 24] = 99;  // the kind
+  const std::size_t length = 5 + kCommandPayloadBytes;
+  const uLong crc = crc32(crc32(0L, Z_NULL, 0), bytes.data() + at, static_cast<uInt>(length));
+  for (int b = 0; b < 4; ++b) {
+    bytes[at + length + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(crc >> (8 * b));
+  }
+  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), {});
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS(("journal offset " + std::to_string(at)).c_str(), read.error.c_str());
+  STRCMP_CONTAINS("a command record's kind, source or outcome is out of range (99, 5, 0", read.error.c_str());
 }
