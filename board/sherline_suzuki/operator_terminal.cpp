@@ -22,9 +22,13 @@ void OperatorTerminal::on_telemetry(const control::Telemetry& frame) {
   if (job_.progress && frame.safe_reason != last_.safe_reason) {
     job_.progress(frame.safe_reason == control::SafeReason::None
                       ? std::string("force restored; the mill stays stopped (re-homing to resume the cut is not built yet)")
-                      : std::string("SAFE STATE: ") + control::safe_reason_name(frame.safe_reason) +
-                            ": no force; the mill is being held and stopped. Hold the handle still near the tool "
+                      : std::string("SAFE STATE: ") + control::safe_reason_name(frame.safe_reason) + " (from " +
+                            control::command_source_name(frame.safe_source) + "): no force; the mill is being held and stopped. Hold the handle still near the tool "
                             "and type 'reset' to feel the part again; Ctrl-C ends the run");
+  }
+  if (job_.progress && frame.paused != last_.paused) {
+    job_.progress(frame.paused ? "PAUSED: the tool and the mill are held where they are; type 'resume' to carry on"
+                               : "resumed");
   }
   if (job_.progress && frame.reset_requests != last_.reset_requests && frame.last_reset != control::ResetOutcome::Accepted) {
     job_.progress(std::string("reset refused: ") + control::reset_outcome_name(frame.last_reset));
@@ -33,8 +37,12 @@ void OperatorTerminal::on_telemetry(const control::Telemetry& frame) {
 }
 
 void OperatorTerminal::forward_requests(control::CommandRing& commands) {
-  if (job_.reset_requested && job_.reset_requested()) {
-    static_cast<void>(commands.push({control::CommandKind::Reset, 0.0, control::CommandSource::Terminal}));
+  // One a pass: a command the full ring cannot take now is typed again by the operator, who sees
+  // nothing happen (the ring holds 16 and the cycle drains it every millisecond).
+  if (job_.operator_command) {
+    if (const std::optional<control::CommandKind> kind = job_.operator_command()) {
+      static_cast<void>(commands.push({*kind, 0.0, control::CommandSource::Terminal}));
+    }
   }
 }
 

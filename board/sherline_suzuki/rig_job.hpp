@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include <Eigen/Core>
@@ -68,8 +69,9 @@ struct RigJob {
   // Once homed, before the spindle starts: blocks until the operator confirms (true) or the job is
   // to end (false: the mill stays homed with the spindle off and the run ends). Null: no confirmation.
   std::function<bool()> confirm_spindle;
-  // Polled by the records thread: true when the operator asks for a reset (typed at the terminal).
-  std::function<bool()> reset_requested;
+  // Polled by the records thread: a command the operator typed at the terminal (stop, pause,
+  // resume, reset), or nothing.
+  std::function<std::optional<control::CommandKind>()> operator_command;
   // Run first on the machine thread, before its first update: stencil-rig gives it SCHED_FIFO below
   // the cycle and above the records thread (app::run_this_thread_fifo); none in the tests.
   std::function<void()> prepare_machine_thread;

@@ -101,7 +101,7 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
 void wire_operator(RigJob& job, int priority, app::TerminalCommands& terminal) {
   job.interrupted = &interrupted;
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
-  job.reset_requested = [&terminal] { return terminal.reset_typed(); };
+  job.operator_command = [&terminal] { return terminal.command_typed(); };
   job.prepare_machine_thread = [priority] {
     constexpr int kBelowTheCycle = 10;
     const app::ThreadPriority got =
@@ -176,8 +176,9 @@ int main(int argc, char** argv) {
       "stencil-rig: the haptic stencil controller on the Sherline + Suzuki rig. Checks the host's real-time\n"
       "readiness, loads the tables, opens the CY545's serial port and the haptic device's link, and says what\n"
       "is missing; then homes the mill and runs the 1 kHz cycle until SIGINT/SIGTERM/SIGHUP/SIGQUIT or --duration, and holds\n"
-      "and stops the mill on the way out. In a fault's safe state (no force, the mill held and\n"
-      "stopped) type 'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
+      "and stops the mill on the way out. While it runs, type 'stop' (the safe state: no force, the mill held and\n"
+      "stopped), 'pause' (feed hold: the tool and the mill held where they are) and 'resume'. In a safe state type\n"
+      "'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
       "stopped (re-homing to resume the cut is not built yet).\n"
       "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened."};
   app::RigOptions o;

@@ -23,29 +23,40 @@ TerminalCommands::Word TerminalCommands::next_word() {
   return closed_ ? Word::Closed : Word::None;
 }
 
-bool TerminalCommands::reset_typed() {
-  if (closed_) {
-    return false;
+std::optional<control::CommandKind> TerminalCommands::command_typed() {
+  if (closed_ && pending_.empty()) {
+    return std::nullopt;
   }
   read_pending();
-  bool reset = false;
   for (std::size_t end = pending_.find('\n'); end != std::string::npos; end = pending_.find('\n')) {
     std::string line = pending_.substr(0, end);
     pending_.erase(0, end + 1);
     while (!line.empty() && (line.back() == '\r' || line.back() == ' ')) {
       line.pop_back();
     }
+    if (line == "stop") {
+      return control::CommandKind::Stop;
+    }
+    if (line == "pause") {
+      return control::CommandKind::Pause;
+    }
+    if (line == "resume") {
+      return control::CommandKind::Resume;
+    }
     if (line == "reset") {
-      reset = true;
-    } else if (!line.empty()) {
-      std::fprintf(stderr, "stencil-rig: '%s' is not a command: type 'reset' (in the safe state) or Ctrl-C to end\n",
+      return control::CommandKind::Reset;
+    }
+    if (!line.empty()) {
+      std::fprintf(stderr,
+                   "stencil-rig: '%s' is not a command: type 'stop', 'pause', 'resume', 'reset' (in the safe state) "
+                   "or Ctrl-C to end\n",
                    line.c_str());
     }
   }
   if (pending_.size() > 1024) {
     pending_.clear();  // a line that long is not a command
   }
-  return reset;
+  return std::nullopt;
 }
 
 void TerminalCommands::read_pending() {

@@ -196,13 +196,13 @@ TEST(RigLoop, APoseJumpIsASafeStateThatAResetLeavesOnceTheHandleIsHeldStill) {
   std::atomic<int> resets_to_send{0};
   std::atomic<bool> running{false};
   rig::RigJob job = rig.job(4.0);
-  job.reset_requested = [&resets_to_send, &running] {  // polled once the machine is homed and the cycle runs
-    running.store(true);
+  job.operator_command = [&resets_to_send, &running]() -> std::optional<control::CommandKind> {
+    running.store(true);  // polled once the machine is homed and the cycle runs
     if (resets_to_send.load() > 0) {
       resets_to_send.fetch_sub(1);
-      return true;
+      return control::CommandKind::Reset;
     }
-    return false;
+    return std::nullopt;
   };
   std::thread operator_hand([&] {
     while (!running.load()) {
