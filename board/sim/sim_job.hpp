@@ -117,6 +117,7 @@ struct SimResult {
   std::string journal_path;     // empty: no journal
   std::uint64_t journal_records = 0;
   std::uint64_t journal_machine_records = 0;
+  std::uint64_t journal_command_records = 0;
   std::string journal_error;    // why the journal stopped, when it could not be written
   // The job before this run, from the journal it resumed (earlier.segments 0: a fresh job), and the
   // touched set's size the journal recorded against the one rebuilt from its virtual tool.

@@ -52,6 +52,7 @@ nlohmann::json simulation_sections(const SimResult& r) {
                                          : nlohmann::json{{"path", r.journal_path},
                                                           {"cycle_records", r.journal_records},
                                                           {"machine_records", r.journal_machine_records},
+                                                          {"command_records", r.journal_command_records},
                                                           {"error", r.journal_error.empty() ? nlohmann::json(nullptr)
                                                                                             : nlohmann::json(r.journal_error)}}},
       {"memory_kb", {{"after_setup", r.rss_after_setup_kb}, {"at_end", r.rss_at_end_kb}, {"most", r.max_rss_kb}}},

@@ -362,6 +362,7 @@ int finish(const app::SimOptions& o, board::sim::SimResult& result, const journa
     result.journal_path = journal_path;
     result.journal_records = journal_writer.cycle_records();
     result.journal_machine_records = journal_writer.machine_records();
+    result.journal_command_records = journal_writer.command_records();
     result.journal_error = closed ? "" : journal_writer.error();
   }
   std::printf("%s", board::sim::summary(result).c_str());

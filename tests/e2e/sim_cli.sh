@@ -55,17 +55,19 @@ at_most() {
 }
 
 # journal_size_ok JOURNAL REPORT EVENTS WHAT: the journal is exactly the file header, its start
-# record, a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command and
-# an 18-byte record per safe-state event (EVENTS), as the report counts them, and the 18-byte end.
+# record, a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command, a
+# 52-byte record per command the cycle took, a 19-byte record per safe-state event (EVENTS), as the
+# report counts them, and the 18-byte end.
 journal_size_ok() {
-  local journal=$1 report=$2 events=$3 what=$4 start cycles commands size expected
+  local journal=$1 report=$2 events=$3 what=$4 start cycles commands taken size expected
   start=$(od -An -tu4 -j12 -N4 "$journal" | tr -d ' ')
   cycles=$(json_number "$report" cycles)
   commands=$(json_number "$report" machine_records)
+  taken=$(json_number "$report" command_records)
   size=$(stat -c %s "$journal")
-  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 18 * events + 18))
+  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 52 * taken + 19 * events + 18))
   [ "$size" -eq "$expected" ] ||
-    fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $events safe-state events)"
+    fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $taken commands taken, $events safe-state events)"
   [ "$commands" -gt 0 ] || fail "$what: no machine command in the journal"
 }
 
@@ -428,6 +430,8 @@ signal_mid_cut() {
   grep -q '"safe_state": "stopped"' report.json || fail "the report does not give the safe state stopped: $(grep safe_state report.json)"
   grep -q "safe state: stopped" stdout.txt || fail "the summary does not say the run was stopped"
   mill_off_at_end report.json "SIG$signal"
+  grep -q '"safe_state_source": "signal"' report.json ||
+    fail "the report does not say the stop came from a signal: $(grep safe_state_source report.json)"
   journal_size_ok job.journal report.json 1 "SIG$signal"
 }
 case_sigterm_mid_cut_ends_in_the_safe_state_with_the_record_kept() { signal_mid_cut TERM; }
