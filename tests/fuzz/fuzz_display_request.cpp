@@ -28,7 +28,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     require(length == kMessageBytes && message.magic == kMessageMagic && message.version == kProtocolVersion);
     const auto kind = static_cast<MessageKind>(message.kind);
-    require(kind == MessageKind::Hello || kind == MessageKind::Set || kind == MessageKind::Reset);
+    require(kind == MessageKind::Hello || kind == MessageKind::Set || kind == MessageKind::Reset || kind == MessageKind::Stop ||
+            kind == MessageKind::Pause || kind == MessageKind::Resume);
     require(std::isfinite(message.value));
     if (kind == MessageKind::Hello) {
       continue;
@@ -53,8 +54,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           break;
       }
     }
+    require(command.source == stencil::control::CommandSource::Display);
     if (request.kind == RequestKind::Reset) {
       require(command.kind == stencil::control::CommandKind::Reset);
+    }
+    // A stop is what it says, always: never another command, never a value.
+    require((kind == MessageKind::Stop) == (command.kind == stencil::control::CommandKind::Stop));
+    require(kind == MessageKind::Set || command.value == 0.0);
+    if (kind == MessageKind::Pause) {
+      require(command.kind == stencil::control::CommandKind::Pause);
+    }
+    if (kind == MessageKind::Resume) {
+      require(command.kind == stencil::control::CommandKind::Resume);
     }
   }
   return 0;
