@@ -161,8 +161,9 @@ function onMessage(message) {
       break;
     }
     case 'refused': {
-      const where = message.request === 'set' || !message.request ? $('param-message') : $('machine-message');
-      where.textContent = `${message.request ?? 'request'} refused: ${message.reason}`;
+      const parameter = message.request === 'set' || !message.request;
+      const where = parameter ? $('param-message') : $('machine-message');
+      where.textContent = parameter ? `refused: ${message.reason}` : `${message.request} refused: ${message.reason}`;
       where.className = 'note state-bad';
       break;
     }
