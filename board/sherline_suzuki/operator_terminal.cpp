@@ -26,7 +26,7 @@ void OperatorTerminal::on_telemetry(const control::Telemetry& frame) {
                             control::command_source_name(frame.safe_source) + "): no force; the mill is being held and stopped. Hold the handle still near the tool "
                             "and type 'reset' to feel the part again; Ctrl-C ends the run");
   }
-  if (job_.progress && frame.paused != last_.paused) {
+  if (job_.progress && frame.paused != last_.paused && (frame.paused || frame.safe_reason == control::SafeReason::None)) {
     job_.progress(frame.paused ? "PAUSED: the tool and the mill are held where they are; type 'resume' to carry on"
                                : "resumed");
   }

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -145,12 +146,28 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
     }
     const bool reason_same = !control::is_device_reason(result.replay_recorded_reason) ||
                              result.safe_state == result.replay_recorded_reason;
+    // The commands came out as recorded too: each taken at the same cycle, to the same outcome and
+    // value (a stop the replay itself adds for a safe state the record gives no command for aside).
+    std::size_t commands_differing = 0;
+    std::vector<control::CommandEvent> replayed;
+    for (const control::CommandEvent& e : result.operator_record.commands) {
+      if (e.source != control::CommandSource::Replay) {
+        replayed.push_back(e);
+      }
+    }
+    for (std::size_t i = 0; i < std::max(replayed.size(), commands.size()); ++i) {
+      const bool both = i < replayed.size() && i < commands.size();
+      const bool equal = both && replayed[i].cycle == commands[i].cycle && replayed[i].kind == commands[i].kind &&
+                         replayed[i].outcome == commands[i].outcome &&
+                         std::memcmp(&replayed[i].applied, &commands[i].applied, sizeof(double)) == 0;
+      commands_differing += equal ? 0 : 1;
+    }
     const bool same = result.replay_mismatches == 0 && result.replay_cycles == records.size() && reason_same &&
-                      result.replay_commands_not_given == 0;
+                      result.replay_commands_not_given == 0 && commands_differing == 0;
     all_same = all_same && same;
-    std::printf("replay run %u: %llu of %zu recorded cycles, %zu recorded commands, %llu cycles with a different virtual "
-                "tool%s; recorded ending %s, replayed %s: %s\n",
-                run, static_cast<unsigned long long>(result.replay_cycles), records.size(), commands.size(),
+    std::printf("replay run %u: %llu of %zu recorded cycles, %zu recorded commands (%zu taken otherwise), %llu cycles "
+                "with a different virtual tool%s; recorded ending %s, replayed %s: %s\n",
+                run, static_cast<unsigned long long>(result.replay_cycles), records.size(), commands.size(), commands_differing,
                 static_cast<unsigned long long>(result.replay_mismatches),
                 result.replay_first_mismatch >= 0 ? (" (the first at cycle " + std::to_string(result.replay_first_mismatch) + ")").c_str() : "",
                 control::safe_reason_name(result.replay_recorded_reason), control::safe_reason_name(result.safe_state),

@@ -429,15 +429,46 @@ TEST(Controller, EachParameterChangeIsAnEventWithTheValueAskedAndTheValueApplied
   }
 }
 
-TEST(Controller, ACommandTheEventRingCannotTakeIsAJournalFault) {
+TEST(Controller, ACommandTheRecordHasNoRoomForIsNotTakenAndIsAJournalFault) {
   Bench bench;
   bench.cycles(5);
   for (std::size_t i = 0; i < CommandEventRing::capacity(); ++i) {
     CHECK(bench.command_events.push({}));  // nobody drains it
   }
   CHECK(bench.commands.push({CommandKind::SetForceLimit, 3.0, CommandSource::Display}));
+  CHECK(bench.commands.push({CommandKind::Pause, 0.0, CommandSource::Display}));
   CHECK(bench.controller->step(bench.now, bench.now) == CycleStatus::SafeState);
   CHECK(bench.controller->safe_reason() == SafeReason::JournalFull);
+  DOUBLES_EQUAL(config().haptic.max_force_n, bench.last_telemetry.force_limit_n, 0.0);  // not applied
+  CHECK_FALSE(bench.controller->paused());
+  LONGS_EQUAL(CommandEventRing::capacity(), bench.command_events.size());
+}
+
+// The run's own stop (a signal, the job's end) is final: a display's reset taken in the same cycle,
+// or after it, does not bring the cycle back, or the run would go on past its end.
+TEST(Controller, AResetAfterTheRunsOwnStopIsRefusedEvenInTheSameCycle) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.display_commands.push({CommandKind::Stop, 0.0, CommandSource::Display}));
+  bench.cycles(600);  // in the safe state, the hand still near the tool: a reset would be taken now
+  CHECK(bench.commands.push({CommandKind::Stop, 0.0, CommandSource::Signal}));
+  CHECK(bench.display_commands.push({CommandKind::Reset, 0.0, CommandSource::Display}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  CHECK(bench.events.back().kind == CommandKind::Reset);
+  CHECK(bench.events.back().outcome == CommandOutcome::RunEnding);
+  CHECK(bench.controller->safe_source() == CommandSource::Display);  // the first reason and source stay
+  LONGS_EQUAL(0, bench.controller->counters().resets_accepted);
+}
+
+TEST(Controller, AResetAfterADisplaysStopIsTakenAsAfterAnyOther) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.display_commands.push({CommandKind::Stop, 0.0, CommandSource::Display}));
+  bench.cycles(600);
+  CHECK(bench.display_commands.push({CommandKind::Reset, 0.0, CommandSource::Display}));
+  CHECK(bench.cycle() == CycleStatus::Running);
+  CHECK(bench.events.back().outcome == CommandOutcome::Done);
+  CHECK(bench.controller->safe_source() == CommandSource::Cycle);
 }
 
 TEST(Controller, TheDevicesOwnFaultFlagEntersTheSafeState) {
@@ -480,7 +511,7 @@ TEST(Controller, TheSafeStateLatchesWhenItsCauseIsGone) {
 TEST(Controller, AResetIsRefusedWhileTheDeviceMovesOrIsFarFromTheToolAndTakenWhenItIsHeldStillNearIt) {
   Bench bench;
   bench.cycles(20);
-  CHECK(bench.commands.push({CommandKind::Stop}));
+  CHECK(bench.commands.push({CommandKind::Stop, 0.0, CommandSource::Terminal}));
   bench.cycles(1);
   // Moving at 10 mm/s: not still.
   for (int i = 0; i < 600; ++i) {
@@ -518,7 +549,7 @@ TEST(Controller, AfterAResetTheForceRampsBackInOverHalfASecond) {
   bench.cycles(10);
   const double full = bench.force_written();
   CHECK(full > 1.0);
-  CHECK(bench.commands.push({CommandKind::Stop}));
+  CHECK(bench.commands.push({CommandKind::Stop, 0.0, CommandSource::Terminal}));
   bench.cycles(1);
   DOUBLES_EQUAL(0.0, bench.force_written(), 0.0);
   bench.cycles(600);  // held still, 2 mm from the virtual tool on the surface

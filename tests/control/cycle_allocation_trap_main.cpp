@@ -59,7 +59,7 @@ int main() {
       static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimit, 20.0, control::CommandSource::Display}));
     }
     if (i == kCycles / 2) {
-      static_cast<void>(commands.push({control::CommandKind::Stop}));
+      static_cast<void>(commands.push({control::CommandKind::Stop, 0.0, control::CommandSource::Terminal}));
       held = 10.0 * controller->virtual_tip_mm();
     }
     const bool holding = i >= kCycles / 2;

@@ -201,6 +201,7 @@ TEST(MachineSideRecording, APauseHoldsTheFeedAndSendsNothingUntilTheResume) {
   const std::size_t records = bench.recorder.queued.size();
   CHECK(moves > 0);
   bench.paused = true;
+  const int beats = bench.link.keep_alives();
   for (int i = 0; i < 6; ++i) {
     bench.update();
     CHECK(bench.link.status().state == hal::MachineState::Held);
@@ -211,6 +212,7 @@ TEST(MachineSideRecording, APauseHoldsTheFeedAndSendsNothingUntilTheResume) {
   LONGS_EQUAL(0, bench.link.refused_while_held());
   LONGS_EQUAL(1, bench.machine->statistics().holds);
   LONGS_EQUAL(6, bench.machine->statistics().held_updates);
+  LONGS_EQUAL(beats + 6, bench.link.keep_alives());  // the watchdog relay's heartbeat goes on
   CHECK(bench.machine->state() == control::MachineSideState::Cutting);  // held, not stopped
   bench.paused = false;
   for (int i = 0; i < 5; ++i) {
@@ -221,4 +223,19 @@ TEST(MachineSideRecording, APauseHoldsTheFeedAndSendsNothingUntilTheResume) {
   CHECK(bench.link.moves().size() > moves);
   LONGS_EQUAL(0, bench.link.refused_while_held());
   LONGS_EQUAL(0, bench.link.stops());
+}
+
+TEST(MachineSideRecording, AStopWhileHeldStopsTheMillAndLeavesNoHoldShowing) {
+  Bench bench;
+  bench.recorder.write_at_once = true;
+  bench.update();
+  bench.paused = true;
+  bench.update();
+  CHECK(bench.machine->held());
+  CHECK(bench.handoffs.push({++bench.cycle, {bench.x_mm, 12.5, 20.0}, true, false}));  // the safe state ends the pause
+  bench.now += kUpdateNs;
+  bench.machine->update(bench.now + 2 * kUpdateNs);
+  CHECK(bench.machine->state() == control::MachineSideState::Stopped);
+  LONGS_EQUAL(1, bench.link.stops());
+  CHECK_FALSE(bench.machine->held());
 }

@@ -142,9 +142,9 @@ case_replay_gives_the_recorded_job_back() {
   expect_status 0
   run_sim --replay job.journal --report replay.json --stock-csv replayed.csv
   expect_status 0
-  grep -q "replay run 0: 40021 of 40021 recorded cycles, 0 recorded commands, 0 cycles with a different virtual tool; recorded ending pose_jump, replayed pose_jump: the same" stdout.txt ||
+  grep -q "replay run 0: 40021 of 40021 recorded cycles, 0 recorded commands (0 taken otherwise), 0 cycles with a different virtual tool; recorded ending pose_jump, replayed pose_jump: the same" stdout.txt ||
     fail "the faulted run did not replay as recorded"
-  grep -Eq "replay run 1: ([0-9]+) of \1 recorded cycles, 0 recorded commands, 0 cycles with a different virtual tool; recorded ending none, replayed none: the same" stdout.txt ||
+  grep -Eq "replay run 1: ([0-9]+) of \1 recorded cycles, 0 recorded commands \(0 taken otherwise\), 0 cycles with a different virtual tool; recorded ending none, replayed none: the same" stdout.txt ||
     fail "the resumed run did not replay as recorded"
   cmp -s resumed.csv replayed.csv || fail "the replayed stock is not the recorded job's"
   run_sim --fast --pattern random --seed 7 --duration 60 --haptic-transport can --journal walk.journal --report walk.json

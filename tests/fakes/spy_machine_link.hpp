@@ -48,7 +48,11 @@ class SpyMachineLink final : public hal::MachineLink {
     status_.spindle_on = on;
     return done();
   }
-  hal::MachineResult keep_alive(hal::MonotonicNs) override { return done(); }
+  hal::MachineResult keep_alive(hal::MonotonicNs) override {
+    ++keep_alives_;
+    return done();
+  }
+  [[nodiscard]] int keep_alives() const { return keep_alives_; }
   void hold() override { status_.state = hal::MachineState::Held; }
   void resume() override { status_.state = hal::MachineState::Homed; }
   hal::MachineResult stop(hal::MonotonicNs) override {
@@ -63,6 +67,7 @@ class SpyMachineLink final : public hal::MachineLink {
 
  private:
   int refused_while_held_ = 0;
+  int keep_alives_ = 0;
   static hal::MachineResult done() { return {true, hal::MachineRefusal::None, hal::MachineFault::None}; }
   hal::MachineStatus status_{hal::MachineState::Ready, hal::MachineFault::None, {0, 0, 0}, false, false, true, 0, 0, 0};
   std::vector<hal::MachineTarget> moves_;

@@ -181,11 +181,19 @@ CommandOutcome Controller::take_command(const Command& command, hal::MonotonicNs
     case CommandKind::Stop:
     case CommandKind::JournalFailed: {
       const bool was_safe = safe_reason_ != SafeReason::None;
+      // The run's own stop (a signal, the job's time up, the journal failing) ends the run: no
+      // reset taken after it, whoever asks, or the run would carry on past its end.
+      run_ending_ = run_ending_ || command.kind == CommandKind::JournalFailed || command.source == CommandSource::Signal ||
+                    command.source == CommandSource::Program;
       enter_safe_state(command.kind == CommandKind::Stop ? SafeReason::Stopped : SafeReason::JournalFailed,
                        command.source);
       return was_safe ? CommandOutcome::AlreadySafe : CommandOutcome::Done;
     }
     case CommandKind::Reset:
+      if (run_ending_) {
+        ++counters_.resets_refused;
+        return CommandOutcome::RunEnding;
+      }
       last_reset_ = try_reset(now_ns);
       ++(last_reset_ == ResetOutcome::Accepted ? counters_.resets_accepted : counters_.resets_refused);
       return outcome_of(last_reset_);
@@ -206,6 +214,9 @@ CommandOutcome Controller::take_command(const Command& command, hal::MonotonicNs
       paused_ = true;
       return CommandOutcome::Done;
     case CommandKind::Resume:
+      // No reset rule here: unlike a reset or a held start, the force never stopped (the hand felt the
+      // held tool all along), so nothing jumps; the tool goes on towards the hand at the speed limit,
+      // along legal moves, and the mill follows.
       if (!paused_) {
         return CommandOutcome::NotPaused;
       }
@@ -223,14 +234,21 @@ void Controller::take_commands(CommandRing& ring, hal::MonotonicNs now_ns) {
     if (!ring.pop(command)) {
       break;
     }
-    const CommandOutcome outcome = take_command(command, now_ns);
-    const bool set = parameter_name(command.kind)[0] != 'n';  // a Set*: "none" for the others
-    const CommandEvent event{cycle_,          now_ns,  command.queued_after_cycle,
-                             command.kind,    command.source, outcome,
-                             set ? command.value : 0.0, set ? parameter_value(command.kind) : 0.0};
-    if (!rings_.command_events.push(event)) {
-      enter_safe_state(SafeReason::JournalFull, CommandSource::Cycle);  // the record would lose it: stop cutting
+    const bool parameter = is_parameter(command.kind);
+    // Recorded, or not taken: a command the record could not hold would make a replay differ. Only
+    // a stop is taken all the same (the safe state it asks for is JournalFull's too).
+    if (rings_.command_events.size() >= CommandEventRing::capacity()) {
+      enter_safe_state(SafeReason::JournalFull, CommandSource::Cycle);
+      if (command.kind == CommandKind::Stop || command.kind == CommandKind::JournalFailed) {
+        static_cast<void>(take_command(command, now_ns));
+      }
+      continue;
     }
+    const CommandOutcome outcome = take_command(command, now_ns);
+    const CommandEvent event{cycle_,          now_ns,         command.queued_after_cycle,
+                             command.kind,    command.source, outcome,
+                             parameter ? command.value : 0.0, parameter ? parameter_value(command.kind) : 0.0};
+    static_cast<void>(rings_.command_events.push(event));  // room checked above: this is its one producer
   }
 }
 
@@ -248,6 +266,7 @@ void Controller::handle_commands(hal::MonotonicNs now_ns) {
       enter_safe_state(SafeReason::MachineFault, CommandSource::Machine);
     } else if (event.kind == MachineEventKind::JournalFailed) {
       enter_safe_state(SafeReason::JournalFailed, CommandSource::Machine);
+      run_ending_ = true;  // nothing after it would be recorded: no reset
     } else if (event.kind == MachineEventKind::Backlog) {
       backlog_percent_ = event.backlog_percent;
     }

@@ -179,6 +179,7 @@ class Controller {
   SafeReason safe_reason_ = SafeReason::None;
   CommandSource safe_source_ = CommandSource::Cycle;
   bool paused_ = false;
+  bool run_ending_ = false;  // the run's own stop was taken: no reset after it
   ResetOutcome last_reset_ = ResetOutcome::NotInSafeState;
   hal::HapticSample sample_{};             // the last accepted sample
   hal::ReadResult read_{hal::ReadStatus::Stale, hal::HapticFault::None};  // this cycle's read, for the journal

@@ -93,6 +93,11 @@ struct Command {
 }
 inline constexpr std::uint8_t kCommandKindCount = 8;
 
+// Whether the command sets one of the operator's parameters.
+[[nodiscard]] constexpr bool is_parameter(CommandKind kind) {
+  return kind == CommandKind::SetCoupling || kind == CommandKind::SetForceLimit || kind == CommandKind::SetSpeedLimit;
+}
+
 // The operator's parameter a Set* command sets, by the name the display uses in its requests and
 // its state feed ("coupling", "force_limit", "speed_limit"); "none" for the other commands.
 [[nodiscard]] constexpr const char* parameter_name(CommandKind kind) {
@@ -174,8 +179,10 @@ enum class CommandOutcome : std::uint8_t {
   NotRunning,         // Pause: the cycle is in its safe state or waits for the hand
   AlreadyPaused,
   NotPaused,          // Resume
+  RunEnding,          // Reset after the run's own stop (a signal, the job's end): the run ends, nothing resets it
+  NoRecordRoom,       // the ring of taken commands was full: not taken (the cycle enters JournalFull)
 };
-inline constexpr std::uint8_t kCommandOutcomeCount = 11;
+inline constexpr std::uint8_t kCommandOutcomeCount = 13;
 
 [[nodiscard]] constexpr const char* command_outcome_name(CommandOutcome outcome) {
   switch (outcome) {
@@ -201,6 +208,10 @@ inline constexpr std::uint8_t kCommandOutcomeCount = 11;
       return "already_paused";
     case CommandOutcome::NotPaused:
       return "not_paused";
+    case CommandOutcome::RunEnding:
+      return "run_ending";
+    case CommandOutcome::NoRecordRoom:
+      return "no_record_room";
   }
   return "unknown";
 }
@@ -303,8 +314,11 @@ using MachineHandoffRing = SpscRing<MachineHandoff, 512>;
 using MachineEventRing = SpscRing<MachineEvent, 16>;
 using TelemetryRing = SpscRing<Telemetry, 64>;
 using JournalRing = SpscRing<JournalRecord, 4096>;
-// At most both command rings' worth a cycle, and the records thread drains it with the journal's.
-using CommandEventRing = SpscRing<CommandEvent, 64>;
+// The records thread drains it with the journal's ring, every 50 ms at most and later when the disk
+// stalls (the journal ring lasts 4 s): 1024 holds far more than the displays (10 requests a second
+// each, 8 of them) and the terminal can send meanwhile. Full, the command is not taken (nothing
+// unrecorded is ever applied) and the cycle enters JournalFull.
+using CommandEventRing = SpscRing<CommandEvent, 1024>;
 
 // Commands into the cycle from one producer thread. It stamps each with the cycles the cycle had
 // begun (the cycle tells it at each look), so the record shows how long a command waited.

@@ -43,6 +43,7 @@ void MachineSide::stop(hal::MonotonicNs deadline_ns, bool report_fault, MachineE
   }
   state_ = MachineSideState::Stopped;
   link_.hold();
+  held_ = false;  // stopped, not the operator's hold: a readout must not show it held
   // The link tries whatever fault it has latched, and says whether the outputs are confirmed off.
   stop_confirmed_ = link_.stop(deadline_ns).done;
   static_cast<void>(to_cycle_.push({.kind = MachineEventKind::Stopped, .stop_confirmed = stop_confirmed_}));

@@ -141,11 +141,15 @@ std::string DisplayLink::decide(const Request& request) const {
   if (request.kind == RequestKind::Set) {
     return refusal(request, own_view_.header().limits);
   }
-  if (request.kind == RequestKind::Stop) {
-    return "";  // always: in the safe state already, the cycle keeps its first reason
-  }
   Figures now{};
-  if (!own_view_.read(now)) {
+  const bool read = own_view_.read(now);
+  if (read && now.phase == JobPhase::Ended) {
+    return "the job has ended";
+  }
+  if (request.kind == RequestKind::Stop) {
+    return "";  // otherwise always: in the safe state already, the cycle keeps its first reason
+  }
+  if (!read) {
     return "the controller is busy; try again";
   }
   if (request.kind == RequestKind::Pause || request.kind == RequestKind::Resume) {

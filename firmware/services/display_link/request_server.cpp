@@ -247,8 +247,19 @@ void RequestServer::handle(Peer& peer, const Message& message) {
     peer.tokens = std::max(0.0, peer.tokens - 1.0);
     refusal = decide_ ? decide_(request) : std::string();
     // Straight into the cycle's ring: the next cycle takes it (this thread is the ring's one producer).
-    if (refusal.empty() && !commands_.push(command_of(request))) {
-      refusal = "too many requests waiting for the cycle; try again";
+    // The last slot is kept for a stop; a stop pressed again within 100 ms of one already sent is the
+    // same stop (accepted, not sent twice), so a held-down key fills neither the ring nor the record.
+    const bool stop = request.kind == RequestKind::Stop;
+    if (refusal.empty() && stop && now - last_stop_s_ < 0.1) {
+      ++stops_merged_;
+    } else if (refusal.empty()) {
+      const bool room = stop ? commands_.size() < control::CommandRing::capacity()
+                             : commands_.size() + 1 < control::CommandRing::capacity();
+      if (!room || !commands_.push(command_of(request))) {
+        refusal = "too many requests waiting for the cycle; try again";
+      } else if (stop) {
+        last_stop_s_ = now;
+      }
     }
     if (!refusal.empty()) {
       ++refused_;

@@ -63,6 +63,8 @@ class RequestServer {
   std::atomic<bool> stopping_{false};
 
   control::CommandRing& commands_;
+  double last_stop_s_ = -1.0;      // the server thread's: when it last pushed a stop
+  std::uint64_t stops_merged_ = 0;  // stops within 100 ms of the last one: the same stop
 
   std::atomic<std::uint64_t> connected_{0}, seen_{0}, accepted_{0}, refused_{0}, rate_limited_{0}, malformed_{0},
       peers_refused_{0};

@@ -29,9 +29,8 @@ nlohmann::json events_json(const display_link::Figures& f) {
     } else {
       item["type"] = control::command_kind_name(e.kind);
       item["outcome"] = control::command_outcome_name(e.outcome);
-      const char* parameter = control::parameter_name(e.kind);
-      if (parameter[0] != 'n') {
-        item["parameter"] = parameter;
+      if (control::is_parameter(e.kind)) {
+        item["parameter"] = control::parameter_name(e.kind);
         item["asked"] = std::isfinite(e.asked) ? nlohmann::json(e.asked) : nlohmann::json(nullptr);
         item["applied"] = std::isfinite(e.applied) ? nlohmann::json(e.applied) : nlohmann::json(nullptr);
       }

@@ -186,13 +186,30 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         const std::uint8_t outcome = body.u8();
         e.asked = body.f64();
         e.applied = body.f64();
-        if (kind >= control::kCommandKindCount || source >= control::kCommandSourceCount ||
-            outcome >= control::kCommandOutcomeCount) {
-          result.error = at(offset) + "a command record's kind, source or outcome is out of range (" +
-                         std::to_string(kind) + ", " + std::to_string(source) + ", " + std::to_string(outcome) +
-                         "; expected below " + std::to_string(control::kCommandKindCount) + ", " +
-                         std::to_string(control::kCommandSourceCount) + ", " +
-                         std::to_string(control::kCommandOutcomeCount) + ")";
+        // Each field named, at its byte in the file (the payload starts after the 5-byte head).
+        const std::size_t payload_at = offset + 5;
+        const struct {
+          std::uint8_t value, count;
+          std::size_t at;
+          const char* name;
+        } fields[] = {{kind, control::kCommandKindCount, 24, "kind"},
+                      {source, control::kCommandSourceCount, 25, "source"},
+                      {outcome, control::kCommandOutcomeCount, 26, "outcome"}};
+        bool bad = false;
+        for (const auto& field : fields) {
+          if (field.value >= field.count) {
+            result.error = at(payload_at + field.at) + "a command record's " + field.name + " is " +
+                           std::to_string(field.value) + " (expected below " + std::to_string(field.count) + ")";
+            bad = true;
+            break;
+          }
+        }
+        if (!bad && (std::isnan(e.asked) || std::isnan(e.applied))) {
+          result.error = at(payload_at + (std::isnan(e.asked) ? 27 : 35)) + "a command record's " +
+                         (std::isnan(e.asked) ? "value asked" : "value applied") + " is not a number";
+          bad = true;
+        }
+        if (bad) {
           return result;
         }
         e.kind = static_cast<control::CommandKind>(kind);

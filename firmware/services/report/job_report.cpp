@@ -83,10 +83,9 @@ nlohmann::json operator_json(const OperatorRecord& r, control::SafeReason safe_s
                            {"source", control::command_source_name(e.source)},
                            {"outcome", control::command_outcome_name(e.outcome)},
                            {"waited_cycles", e.cycle - std::min(e.cycle, e.queued_after_cycle)}};
-    const char* parameter = control::parameter_name(e.kind);
-    const bool set = parameter[0] != 'n';
+    const bool set = control::is_parameter(e.kind);
     if (set) {
-      item["parameter"] = parameter;
+      item["parameter"] = control::parameter_name(e.kind);
       item["asked"] = finite_or_null(e.asked);
       item["applied"] = finite_or_null(e.applied);
     }
