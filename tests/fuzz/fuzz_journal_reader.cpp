@@ -63,6 +63,18 @@ int read_and_check(const std::uint8_t* data, std::size_t size) {
         require(reason != stencil::control::SafeReason::None);
         ++visits;
       },
+      // The same safe-state record again, with its source: not another record.
+      [&](std::uint64_t, stencil::control::SafeReason reason, stencil::control::CommandSource source) {
+        require(reason != stencil::control::SafeReason::None);
+        require(static_cast<int>(source) < stencil::control::kCommandSourceCount);
+      },
+      [&](const stencil::control::CommandEvent& e) {
+        require(static_cast<int>(e.kind) < stencil::control::kCommandKindCount);
+        require(static_cast<int>(e.source) < stencil::control::kCommandSourceCount);
+        require(static_cast<int>(e.outcome) < stencil::control::kCommandOutcomeCount);
+        require(e.asked == e.asked && e.applied == e.applied);  // not NaN
+        ++visits;
+      },
       [&](std::int64_t) { ++visits; },
       [&](const stencil::control::MachineCommandRecord& c) {
         for (int i = 0; i < 3; ++i) {
