@@ -192,9 +192,15 @@ async function setParameter(page, input, name, value) {
   if (journal.safeStates.length !== 1 || safe.cycle !== stop.cycle || safe.source !== 'display') {
     fail(`the safe state is not the stop's cycle's: ${JSON.stringify(journal.safeStates)}`);
   }
+  // The mill: stopped by the next machine update (the one under way when the stop came finishes its
+  // move first: within two update periods, as the fault cases check), and no machine command planned
+  // by an update that began after the stop (a command's time is its update's start + 3 updates).
   const m = report.machine;
-  console.log(`safe state at ${m.safe_state_s} s, mill stopped at ${m.stopped_s} s (simulated)`);
-  if (!(m.stopped_s - m.safe_state_s <= 1 / 30 + 1e-3)) fail('the mill was not stopped by the next machine update');
+  const plannedAfterStop = journal.machine.filter((c) => c.timeNs - 3 * UPDATE_NS > stop.timeNs);
+  console.log(`safe state at ${m.safe_state_s} s, mill stopped at ${m.stopped_s} s (simulated); ` +
+    `${plannedAfterStop.length} machine commands planned after the stop`);
+  if (!(m.stopped_s - m.safe_state_s <= 2 / 30 + 1e-3)) fail('the mill was not stopped by the next machine update');
+  if (plannedAfterStop.length !== 0) fail('a machine command was planned after the stop');
 
   // The pause: no machine command planned while it held, the virtual tool still.
   const pause = journal.commands.find((c) => c.kind === 'pause');
