@@ -91,6 +91,49 @@ std::string picture_path_of(const std::string& report_path) {
          ".svg";
 }
 
+// One run of a journal (0: the first, 1 the first resume, ...): its cycles and the commands they took.
+bool read_run(const std::string& path, std::uint32_t run, std::size_t good_bytes, std::vector<control::JournalRecord>& records,
+              std::vector<control::CommandEvent>& commands, std::string& error) {
+  std::uint32_t in_run = 0;
+  journal::JournalVisitor keep;
+  keep.resume = [&](const journal::JournalResume&) { ++in_run; };
+  keep.cycle = [&](const control::JournalRecord& r) {
+    if (in_run == run) {
+      records.push_back(r);
+    }
+  };
+  keep.command = [&](const control::CommandEvent& e) {
+    if (in_run == run) {
+      commands.push_back(e);
+    }
+  };
+  const journal::JournalReadResult read = journal::read_journal_file(path, keep, good_bytes);
+  error = read.error;
+  return read.ok;
+}
+
+// How many of the recorded commands the replay did not take the same way: at the same cycle, to the
+// same outcome and value (a stop the replay itself adds, for a safe state the record gives no command
+// for, aside).
+std::size_t commands_differing_from(const std::vector<control::CommandEvent>& recorded,
+                                    const std::vector<control::CommandEvent>& taken) {
+  std::vector<control::CommandEvent> replayed;
+  for (const control::CommandEvent& e : taken) {
+    if (e.source != control::CommandSource::Replay) {
+      replayed.push_back(e);
+    }
+  }
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < std::max(replayed.size(), recorded.size()); ++i) {
+    const bool both = i < replayed.size() && i < recorded.size();
+    const bool equal = both && replayed[i].cycle == recorded[i].cycle && replayed[i].kind == recorded[i].kind &&
+                       replayed[i].outcome == recorded[i].outcome &&
+                       std::memcmp(&replayed[i].applied, &recorded[i].applied, sizeof(double)) == 0;
+    differing += equal ? 0 : 1;
+  }
+  return differing;
+}
+
 // --replay: every run the journal holds, in turn, each from the state the runs before it left.
 int replay(const std::string& path, const tables::PartTables& part, board::sim::SimJob job, const std::string& report_path,
            const std::string& stock_csv_path, double pace) {
@@ -118,22 +161,8 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
   for (std::uint32_t run = 0; run < history.segments; ++run) {
     std::vector<control::JournalRecord> records;
     std::vector<control::CommandEvent> commands;
-    std::uint32_t in_run = 0;
-    journal::JournalVisitor keep;
-    keep.resume = [&](const journal::JournalResume&) { ++in_run; };
-    keep.cycle = [&](const control::JournalRecord& r) {
-      if (in_run == run) {
-        records.push_back(r);
-      }
-    };
-    keep.command = [&](const control::CommandEvent& e) {
-      if (in_run == run) {
-        commands.push_back(e);
-      }
-    };
-    const journal::JournalReadResult read = journal::read_journal_file(path, keep, history.good_bytes);
-    if (!read.ok) {
-      return bad_input("--replay: " + read.error);
+    if (!read_run(path, run, history.good_bytes, records, commands, error)) {
+      return bad_input("--replay: " + error);
     }
     job.replay = &records;
     job.replay_commands = &commands;
@@ -146,22 +175,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
     }
     const bool reason_same = !control::is_device_reason(result.replay_recorded_reason) ||
                              result.safe_state == result.replay_recorded_reason;
-    // The commands came out as recorded too: each taken at the same cycle, to the same outcome and
-    // value (a stop the replay itself adds for a safe state the record gives no command for aside).
-    std::size_t commands_differing = 0;
-    std::vector<control::CommandEvent> replayed;
-    for (const control::CommandEvent& e : result.operator_record.commands) {
-      if (e.source != control::CommandSource::Replay) {
-        replayed.push_back(e);
-      }
-    }
-    for (std::size_t i = 0; i < std::max(replayed.size(), commands.size()); ++i) {
-      const bool both = i < replayed.size() && i < commands.size();
-      const bool equal = both && replayed[i].cycle == commands[i].cycle && replayed[i].kind == commands[i].kind &&
-                         replayed[i].outcome == commands[i].outcome &&
-                         std::memcmp(&replayed[i].applied, &commands[i].applied, sizeof(double)) == 0;
-      commands_differing += equal ? 0 : 1;
-    }
+    const std::size_t commands_differing = commands_differing_from(commands, result.operator_record.commands);
     const bool same = result.replay_mismatches == 0 && result.replay_cycles == records.size() && reason_same &&
                       result.replay_commands_not_given == 0 && commands_differing == 0;
     all_same = all_same && same;
