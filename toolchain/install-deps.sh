@@ -38,6 +38,7 @@ packages=(
   zlib1g-dev         # CRC-32 of the table files
   nettle-dev         # SHA-256 of the source STL in the table header
   libcli11-dev       # the table generator's command line
+  libtomlplusplus-dev  # the rig's configuration file (header-only)
   nlohmann-json3-dev # --inspect --json
   libfcl-dev         # stencil-bench compares the engine with the Flexible Collision Library
   clang              # the fuzz preset's compiler (libFuzzer needs clang)

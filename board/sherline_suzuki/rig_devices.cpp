@@ -8,19 +8,19 @@
 namespace stencil::board::sherline_suzuki {
 namespace {
 
-bool open_pio(const std::string& path, RigDevices& devices, std::string& error) {
+bool open_pio(const hal::HapticRange& range, const std::string& path, RigDevices& devices, std::string& error) {
   devices.window = hal::pio_shared_memory::SharedWindowMapping::open(path, 0, true, error);
   if (devices.window == nullptr) {
     error = "the haptic device's PIO window: " + error;
     return false;
   }
   devices.pio_device =
-      std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&devices.window->window(), kDeviceRange);
+      std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&devices.window->window(), range);
   devices.device = devices.pio_device.get();
   return true;
 }
 
-bool open_can(const std::string& interface, RigDevices& devices, const std::function<void(const std::string&)>& note,
+bool open_can(const hal::HapticRange& range, const std::string& interface, RigDevices& devices, const std::function<void(const std::string&)>& note,
               std::string& error) {
   const canid_t ids[] = {hal::socketcan::kPoseAId, hal::socketcan::kPoseBId, hal::socketcan::kStatusId};
   const int fd = hal::socketcan::open_can_raw_socket(interface, ids, 3, error);
@@ -37,7 +37,7 @@ bool open_can(const std::string& interface, RigDevices& devices, const std::func
   }
   note(bitrate_note);
   devices.can_device =
-      std::make_unique<hal::socketcan::SocketCanHapticDevice>(devices.channel.get(), kDeviceRange);
+      std::make_unique<hal::socketcan::SocketCanHapticDevice>(devices.channel.get(), range);
   devices.device = devices.can_device.get();
   return true;
 }
@@ -48,19 +48,20 @@ bool is_haptic_link_name(const std::string& haptic) {
   return (haptic.rfind("pio:", 0) == 0 || haptic.rfind("can:", 0) == 0) && haptic.size() > 4;
 }
 
-bool open_rig_devices(const std::string& serial_path, const std::string& haptic, RigDevices& devices,
-                      const std::function<void(const std::string&)>& note, std::string& error) {
+bool open_rig_devices(const RigFacts& facts, const std::string& serial_path, const std::string& haptic,
+                      RigDevices& devices, const std::function<void(const std::string&)>& note, std::string& error) {
   char port_error[256] = {};
-  if (!devices.port.open(serial_path.c_str(), kRig.serial_baud, port_error)) {
+  if (!devices.port.open(serial_path.c_str(), facts.serial_baud, port_error)) {
     error = std::string("the mill's CY545: ") + port_error;
     return false;
   }
-  const bool opened = haptic.rfind("pio:", 0) == 0 ? open_pio(haptic.substr(4), devices, error)
-                                                   : open_can(haptic.substr(4), devices, note, error);
+  const hal::HapticRange range = programs_device_range(facts);
+  const bool opened = haptic.rfind("pio:", 0) == 0 ? open_pio(range, haptic.substr(4), devices, error)
+                                                   : open_can(range, haptic.substr(4), devices, note, error);
   if (!opened) {
     return false;
   }
-  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, kCy545);
+  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, cy545_config(facts));
   return true;
 }
 

@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "board/sherline_suzuki/rig_facts.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/cy545/serial_port.hpp"
 #include "hal/haptic_device.hpp"
@@ -33,9 +34,11 @@ struct RigDevices {
 // True when `haptic` names a link this board knows: "pio:PATH" or "can:IFACE".
 [[nodiscard]] bool is_haptic_link_name(const std::string& haptic);
 
-// Opens the serial port and the haptic link; `note` gets a line worth telling (the CAN bus's bitrate).
-// False with `error` naming the link.
-[[nodiscard]] bool open_rig_devices(const std::string& serial_path, const std::string& haptic, RigDevices& devices,
+// Opens the serial port and the haptic link of the rig `facts` describe (its baud, the device's range,
+// the CY545's configuration); `note` gets a line worth telling (the CAN bus's bitrate). False with
+// `error` naming the link.
+[[nodiscard]] bool open_rig_devices(const RigFacts& facts, const std::string& serial_path, const std::string& haptic,
+                                    RigDevices& devices,
                                     const std::function<void(const std::string&)>& note, std::string& error);
 
 }  // namespace stencil::board::sherline_suzuki

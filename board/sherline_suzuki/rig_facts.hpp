@@ -42,6 +42,7 @@ struct RigFacts {
   double homing_slack_mm;                   // above the largest backlash
   double homing_travel_mm;                  // more than the whole travel
   double home_switch_zone_mm;               // more than home_overtravel_mm: a switch closed this far out is miswired
+  std::array<std::uint8_t, 3> homing_order; // the axes in the order they home (0 x, 1 y, 2 z): Z first
   // The hardware watchdog relay in the spindle's and drivers' power: it opens when the heartbeat output
   // has not changed for this long (the driver toggles it every heartbeat period / 2).
   hal::MonotonicNs watchdog_relay_timeout_ns;
@@ -68,6 +69,8 @@ struct RigFacts {
   int overrun_limit;                        // more overruns in a row than this: a safe state
   int stale_periods;                        // more periods than this without a fresh sample: a safe state
   bool start_held;                          // the cycle starts held until the hand is held still near the tool
+
+  bool operator==(const RigFacts&) const = default;  // a configuration against the compiled-in defaults
 };
 
 inline constexpr RigFacts kRig{
@@ -95,6 +98,7 @@ inline constexpr RigFacts kRig{
     .homing_slack_mm = 0.4,
     .homing_travel_mm = 64.0,
     .home_switch_zone_mm = 4.0,
+    .homing_order = {2, 0, 1},
     .watchdog_relay_timeout_ns = 1'000'000'000,
     .haptic_workspace_mm = {500.0, 250.0, 250.0},
     .device_reach_margin_mm = 25.0,
@@ -111,93 +115,121 @@ inline constexpr RigFacts kRig{
     .start_held = true,
 };
 
-// ---- What follows from the facts.
+// ---- What follows from the facts (of any rig the configuration describes: rig_config.hpp; the
+// constants below are this rig's, the compiled-in defaults).
 
 inline constexpr int kAxisCount = 3;
 
 // The cycle's period and the machine's update, in nanoseconds (1 ms; 33.3 ms, truncated).
-inline constexpr hal::MonotonicNs kPeriodNs = static_cast<hal::MonotonicNs>(1e9 / kRig.haptic_rate_hz);
-inline constexpr hal::MonotonicNs kUpdateNs = static_cast<hal::MonotonicNs>(1e9 / kRig.machine_update_hz);
+inline constexpr hal::MonotonicNs period_ns(const RigFacts& facts) {
+  return static_cast<hal::MonotonicNs>(1e9 / facts.haptic_rate_hz);
+}
+inline constexpr hal::MonotonicNs update_ns(const RigFacts& facts) {
+  return static_cast<hal::MonotonicNs>(1e9 / facts.machine_update_hz);
+}
+inline constexpr hal::MonotonicNs kPeriodNs = period_ns(kRig);
+inline constexpr hal::MonotonicNs kUpdateNs = update_ns(kRig);
 static_assert(kPeriodNs == 1'000'000 && kUpdateNs == 1'000'000'000 / 30);
 
 // Where the tool tip is in the world with the machine at home, before any touch-off: the workspace's
 // far top corner (X and Y's switches at the table's travel end, Z's at the top), so that every axis
 // counts from there into the workspace (machine_sign).
-inline constexpr std::array<double, 3> kHomeWorldMm = kRig.workspace_mm;
+inline constexpr std::array<double, 3> home_world_mm(const RigFacts& facts) { return facts.workspace_mm; }
+inline constexpr std::array<double, 3> kHomeWorldMm = home_world_mm(kRig);
 
-inline constexpr double largest_backlash_mm() {
+inline constexpr double largest_backlash_mm(const RigFacts& facts = kRig) {
   double largest = 0.0;
-  for (const double backlash : kRig.backlash_mm) {
+  for (const double backlash : facts.backlash_mm) {
     largest = backlash > largest ? backlash : largest;
   }
   return largest;
 }
 
-inline constexpr double travel_min_mm(int axis) {
+inline constexpr double travel_min_mm(int axis, const RigFacts& facts = kRig) {
   static_cast<void>(axis);
-  return kRig.home_switch_edge_mm - kRig.home_overtravel_mm;
+  return facts.home_switch_edge_mm - facts.home_overtravel_mm;
 }
-inline constexpr double travel_max_mm(int axis) {
-  return kRig.workspace_mm[static_cast<std::size_t>(axis)] + kRig.far_overtravel_mm;
+inline constexpr double travel_max_mm(int axis, const RigFacts& facts = kRig) {
+  return facts.workspace_mm[static_cast<std::size_t>(axis)] + facts.far_overtravel_mm;
 }
 
 // Millimetres to whole motor steps, rounded to nearest (every value used here is a whole number).
-inline constexpr long long mm_to_steps(double mm) {
-  const double steps = mm * kRig.steps_per_mm;
+inline constexpr long long mm_to_steps(double mm, const RigFacts& facts = kRig) {
+  const double steps = mm * facts.steps_per_mm;
   return static_cast<long long>(steps < 0.0 ? steps - 0.5 : steps + 0.5);
 }
 
 // Backlash per axis in motor steps: 80, 32, 80.
-inline constexpr long long backlash_steps(int axis) { return mm_to_steps(kRig.backlash_mm[static_cast<std::size_t>(axis)]); }
+inline constexpr long long backlash_steps(int axis, const RigFacts& facts = kRig) {
+  return mm_to_steps(facts.backlash_mm[static_cast<std::size_t>(axis)], facts);
+}
 static_assert(backlash_steps(0) == 80 && backlash_steps(1) == 32 && backlash_steps(2) == 80,
               "backlash must be a whole number of steps");
 
 // What the machine side's planner may spend: the mill's speed, one update, the backlash to take up.
-inline constexpr motion::PlannerLimits kPlannerLimits{
-    {kRig.max_speed_mm_per_s, kRig.step_rate_steps_per_s, kRig.steps_per_mm},
-    1.0 / kRig.machine_update_hz,
-    {static_cast<std::int32_t>(backlash_steps(0)), static_cast<std::int32_t>(backlash_steps(1)),
-     static_cast<std::int32_t>(backlash_steps(2))}};
+inline constexpr motion::PlannerLimits planner_limits(const RigFacts& facts) {
+  return {{facts.max_speed_mm_per_s, facts.step_rate_steps_per_s, facts.steps_per_mm},
+          1.0 / facts.machine_update_hz,
+          {static_cast<std::int32_t>(backlash_steps(0, facts)), static_cast<std::int32_t>(backlash_steps(1, facts)),
+           static_cast<std::int32_t>(backlash_steps(2, facts))}};
+}
+inline constexpr motion::PlannerLimits kPlannerLimits = planner_limits(kRig);
 
-// The standoff covers every staircase the planner falls back on (13.5 um on this rig: 5 steps per axis).
-static_assert(kRig.machine_standoff_mm >= motion::follow_standoff_needed_mm(
-                                              kRig.steps_per_mm, kRig.virtual_tool_speed_mm_per_s / kRig.haptic_rate_hz),
+// The standoff the planner's fallback staircase needs at this rig's steps and cycle (13.5 um on this
+// rig: 5 steps per axis); the configured one must cover it.
+inline constexpr double standoff_needed_mm(const RigFacts& facts) {
+  return motion::follow_standoff_needed_mm(facts.steps_per_mm, facts.virtual_tool_speed_mm_per_s / facts.haptic_rate_hz);
+}
+static_assert(kRig.machine_standoff_mm >= standoff_needed_mm(kRig),
               "the standoff is under what the planner's fallback staircase needs");
 static_assert(motion::follow_fallback_fits(kPlannerLimits), "one update's budget must cover the fallback staircase");
 
-// The CY545 driver's configuration on this rig: its wiring, and its rates and homing in motor steps.
-inline constexpr hal::cy545::Cy545Motion kCy545Motion{
-    .step_rate = static_cast<std::uint32_t>(kRig.step_rate_steps_per_s),
-    .update_period_s = 1.0 / kRig.machine_update_hz,
-    .homing_rate = static_cast<std::uint32_t>(mm_to_steps(kRig.homing_speed_mm_per_s)),
-    .homing_slow_rate = static_cast<std::uint32_t>(mm_to_steps(kRig.homing_slow_speed_mm_per_s)),
-    .homing_chunk_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_chunk_mm)),
-    .homing_slack_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_slack_mm)),
-    .homing_travel_steps = static_cast<std::int32_t>(mm_to_steps(kRig.homing_travel_mm)),
-    .home_switch_zone_steps = static_cast<std::int32_t>(mm_to_steps(kRig.home_switch_zone_mm)),
-};
+// The CY545 driver's configuration on a rig: its wiring, and its rates and homing in motor steps.
+inline constexpr hal::cy545::Cy545Motion cy545_motion(const RigFacts& facts) {
+  return {
+      .step_rate = static_cast<std::uint32_t>(facts.step_rate_steps_per_s),
+      .update_period_s = 1.0 / facts.machine_update_hz,
+      .homing_rate = static_cast<std::uint32_t>(mm_to_steps(facts.homing_speed_mm_per_s, facts)),
+      .homing_slow_rate = static_cast<std::uint32_t>(mm_to_steps(facts.homing_slow_speed_mm_per_s, facts)),
+      .homing_chunk_steps = static_cast<std::int32_t>(mm_to_steps(facts.homing_chunk_mm, facts)),
+      .homing_slack_steps = static_cast<std::int32_t>(mm_to_steps(facts.homing_slack_mm, facts)),
+      .homing_travel_steps = static_cast<std::int32_t>(mm_to_steps(facts.homing_travel_mm, facts)),
+      .home_switch_zone_steps = static_cast<std::int32_t>(mm_to_steps(facts.home_switch_zone_mm, facts)),
+      .homing_order = facts.homing_order,
+  };
+}
+inline constexpr hal::cy545::Cy545Config cy545_config(const RigFacts& facts) {
+  return {facts.mmc4s, cy545_motion(facts)};
+}
+inline constexpr hal::cy545::Cy545Motion kCy545Motion = cy545_motion(kRig);
 static_assert(kCy545Motion.homing_rate == 800 && kCy545Motion.homing_slow_rate == 200 &&
               kCy545Motion.homing_chunk_steps == 64 && kCy545Motion.homing_slack_steps == 256 &&
               kCy545Motion.homing_travel_steps == 40960 && kCy545Motion.home_switch_zone_steps == 2560);
 static_assert(kRig.homing_speed_mm_per_s < kRig.max_speed_mm_per_s && kRig.homing_slack_mm > largest_backlash_mm() &&
               kRig.home_switch_zone_mm > kRig.home_overtravel_mm);
-inline constexpr hal::cy545::Cy545Config kCy545{kRig.mmc4s, kCy545Motion};
+inline constexpr hal::cy545::Cy545Config kCy545 = cy545_config(kRig);
 
 // What the haptic backends accept from this device: its reach plus the margin per side around
 // `centre_mm`, the two angles, the force and torque limits.
-inline constexpr hal::HapticRange device_range(const std::array<double, 3>& centre_mm) {
-  return {{kRig.haptic_workspace_mm[0] / 2.0 + kRig.device_reach_margin_mm,
-           kRig.haptic_workspace_mm[1] / 2.0 + kRig.device_reach_margin_mm,
-           kRig.haptic_workspace_mm[2] / 2.0 + kRig.device_reach_margin_mm},
-          kRig.angle_limit_rad,
-          kRig.force_limit_n,
-          kRig.torque_limit_nmm,
+inline constexpr hal::HapticRange device_range(const RigFacts& facts, const std::array<double, 3>& centre_mm) {
+  return {{facts.haptic_workspace_mm[0] / 2.0 + facts.device_reach_margin_mm,
+           facts.haptic_workspace_mm[1] / 2.0 + facts.device_reach_margin_mm,
+           facts.haptic_workspace_mm[2] / 2.0 + facts.device_reach_margin_mm},
+          facts.angle_limit_rad,
+          facts.force_limit_n,
+          facts.torque_limit_nmm,
           {centre_mm[0], centre_mm[1], centre_mm[2]}};
+}
+inline constexpr hal::HapticRange device_range(const std::array<double, 3>& centre_mm) {
+  return device_range(kRig, centre_mm);
 }
 // The programs' frame: the device's origin at a corner of its reach, device space [0, 500] x [0, 250]
 // x [0, 250] (world = device / 10).
-inline constexpr hal::HapticRange kDeviceRange =
-    device_range({kRig.haptic_workspace_mm[0] / 2.0, kRig.haptic_workspace_mm[1] / 2.0, kRig.haptic_workspace_mm[2] / 2.0});
+inline constexpr hal::HapticRange programs_device_range(const RigFacts& facts) {
+  return device_range(facts, {facts.haptic_workspace_mm[0] / 2.0, facts.haptic_workspace_mm[1] / 2.0,
+                              facts.haptic_workspace_mm[2] / 2.0});
+}
+inline constexpr hal::HapticRange kDeviceRange = programs_device_range(kRig);
 // The same reach centred on the origin (the backends' own frame, as their tests use it).
 inline constexpr hal::HapticRange kCentredDeviceRange = device_range({0.0, 0.0, 0.0});
 

@@ -15,10 +15,6 @@
 namespace stencil::board::sherline_suzuki {
 namespace {
 
-// kPeriodNs and kUpdateNs: rig_facts.hpp.
-constexpr double kModelCellMm = kRig.stock_model_cell_mm;
-constexpr double kVirtualToolSpeedMmPerS = kRig.virtual_tool_speed_mm_per_s;
-
 runtime::JobParts parts_of(const RigJob& job) {
   runtime::JobParts parts;
   parts.part = job.part;
@@ -26,12 +22,12 @@ runtime::JobParts parts_of(const RigJob& job) {
   parts.machine = job.machine;
   parts.machine_clock = job.machine_clock;
   parts.controller = rig_controller_config(job);
-  parts.planner = kPlannerLimits;
-  parts.period_ns = kPeriodNs;
-  parts.update_ns = kUpdateNs;
-  parts.shut_down_bound_ns = 2 * kUpdateNs;
+  parts.planner = planner_limits(job.facts);
+  parts.period_ns = period_ns(job.facts);
+  parts.update_ns = update_ns(job.facts);
+  parts.shut_down_bound_ns = 2 * update_ns(job.facts);
   parts.stock = job.stock;
-  parts.model_cell_mm = kModelCellMm;
+  parts.model_cell_mm = job.facts.stock_model_cell_mm;
   parts.journal = job.journal;
   parts.resume_from = job.resume_from;
   parts.resume_bytes = job.resume_bytes;
@@ -72,18 +68,18 @@ void fill_result(RigResult& result, const runtime::Job& assembled, const runtime
 
 }  // namespace
 
-motion::MachineFrames rig_frames(const WorkOffset& offset) {
+motion::MachineFrames rig_frames(const WorkOffset& offset, const RigFacts& facts) {
   Eigen::Vector3d home = offset.home_world_mm;
   home.z() -= offset.tool_stick_out_mm - offset.reference_stick_out_mm;
-  return {kRig.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, kRig.machine_sign, kRig.steps_per_mm};
+  return {facts.haptic_to_machine_scale, Eigen::Vector3d::Zero(), home, facts.machine_sign, facts.steps_per_mm};
 }
 
 control::ControllerConfig rig_controller_config(const RigJob& job) {
-  const Eigen::Vector3d device_workspace_mm(kRig.haptic_workspace_mm[0], kRig.haptic_workspace_mm[1],
-                                            kRig.haptic_workspace_mm[2]);
+  const RigFacts& f = job.facts;
+  const Eigen::Vector3d device_workspace_mm(f.haptic_workspace_mm[0], f.haptic_workspace_mm[1], f.haptic_workspace_mm[2]);
   control::ControllerConfig config = runtime::controller_config(
-      {rig_frames(job.offset), device_workspace_mm, kRig.device_reach_margin_mm, kRig.force_limit_n,
-       kRig.torque_limit_nmm, 1.0 / kRig.haptic_rate_hz, kVirtualToolSpeedMmPerS, kRig.machine_standoff_mm, true});
+      {rig_frames(job.offset, f), device_workspace_mm, f.device_reach_margin_mm, f.force_limit_n, f.torque_limit_nmm,
+       1.0 / f.haptic_rate_hz, f.virtual_tool_speed_mm_per_s, f.machine_standoff_mm, true});
   config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.overrun_limit = job.overrun_limit;
   config.stale_periods = job.stale_periods;
@@ -103,7 +99,7 @@ RigResult run_rig(const RigJob& job, const runtime::PeriodicRunner& runner) {
   result.touched_rebuilt = assembled.touched_rebuilt();
   // Nothing turns the spindle on unattended: the operator confirms it once the mill is homed.
   runtime::MachineStart start;
-  start.after_homing_within_ns = 2 * kUpdateNs;
+  start.after_homing_within_ns = 2 * update_ns(job.facts);
   start.confirm_spindle = job.confirm_spindle;
   const runtime::StartFailure failure = assembled.start_machine(start);
   if (failure != runtime::StartFailure::None) {
@@ -119,7 +115,7 @@ RigResult run_rig(const RigJob& job, const runtime::PeriodicRunner& runner) {
   // force) for a reset, never an automatic one.
   options.safe_state_ends = runtime::SafeStateEnds::AfterStop;
   options.stop_after_s = job.duration_s;
-  options.settle_ns = 3 * kUpdateNs;  // two machine updates: the safe state reaches the mill (hold, then stop)
+  options.settle_ns = 3 * update_ns(job.facts);  // two machine updates: the safe state reaches the mill (hold, then stop)
   options.prepare_machine_thread = job.prepare_machine_thread;
   const runtime::RunOutcome outcome = runtime::run_on_threads(assembled, runner, hooks, options);
   fill_result(result, assembled, outcome);

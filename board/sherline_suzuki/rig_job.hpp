@@ -39,9 +39,10 @@ struct WorkOffset {
 
 // The rig's frames: world = device / 10, every axis counting into the workspace from its switch;
 // a tool that sticks out further puts the tip lower at home.
-[[nodiscard]] motion::MachineFrames rig_frames(const WorkOffset& offset);
+[[nodiscard]] motion::MachineFrames rig_frames(const WorkOffset& offset, const RigFacts& facts = kRig);
 
 struct RigJob {
+  RigFacts facts = kRig;                // the rig: compiled in, or from its configuration file (rig_config.hpp)
   const tables::PartTables* part = nullptr;
   hal::HapticDevice* device = nullptr;
   hal::MachineLink* machine = nullptr;

@@ -1,5 +1,6 @@
 #include "firmware/programs/rig_options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -31,14 +32,23 @@ bool parse_numbers(const std::string& text, std::vector<double>& out, std::size_
 }
 
 void add_job_options(CLI::App& app, RigOptions& o) {
-  app.add_option("--tables", o.tables_path, "the part's .stbl")->required();
-  app.add_option("--serial", o.serial_path, "the CY545's serial port, e.g. /dev/ttyS0")->required();
-  app.add_option("--haptic", o.haptic, "the haptic link: pio:/dev/uioN or can:IFACE")->required();
+  app.add_option("--config", o.config_path,
+                 "the rig's configuration file (TOML, e.g. /etc/stencil/rig.toml; the example with every key: "
+                 "board/sherline_suzuki/rig.toml): checked before anything is opened. Without it, the compiled-in "
+                 "Sherline/Suzuki rig; the options below override the file");
+  app.add_flag("--config-keys", o.config_keys, "print every key of the configuration file with its type, unit and range, and exit");
+  app.add_option("--tables", o.tables_path, "the part's .stbl (required)");
+  app.add_option("--serial", o.serial_path, "the CY545's serial port, e.g. /dev/ttyS0 (default: the file's machine.serial_port)");
+  app.add_option("--haptic", o.haptic, "the haptic link: pio:/dev/uioN or can:IFACE (default: the file's haptic.link)");
   app.add_flag("--require-rt", o.require_rt, "refuse to run without PREEMPT_RT and SCHED_FIFO");
-  app.add_option("--priority", o.priority, "the cycle thread's SCHED_FIFO priority")->check(CLI::Range(1, 99))->capture_default_str();
-  app.add_option("--cpu", o.cpu, "pin the cycle thread to this CPU (the other threads keep off it)")->check(CLI::NonNegativeNumber);
+  app.add_option("--priority", o.priority, "the cycle thread's SCHED_FIFO priority (default: the file's threads.cycle_priority)")
+      ->check(CLI::Range(2, 99))
+      ->capture_default_str();
+  app.add_option("--cpu", o.cpu, "pin the cycle thread to this CPU, the other threads kept off it (default: the file's threads.cycle_cpu)")
+      ->check(CLI::NonNegativeNumber);
   app.add_option("--work-offset", o.offset_text,
-                 "X,Y,Z: where the tool tip is in the part's coordinates (mm) with the machine at home, from the touch-off")
+                 "X,Y,Z: where the tool tip is in the part's coordinates (mm) with the machine at home, from the "
+                 "touch-off (default: the file's job.work_offset_mm)")
       ->capture_default_str();
   app.add_option("--tool-stick-out", o.stick_out, "the tool's stick-out below the holder (mm); with --reference-stick-out")
       ->check(CLI::Range(0.0, 100.0))
@@ -66,8 +76,8 @@ void add_record_options(CLI::App& app, RigOptions& o) {
       ->check(CLI::NonNegativeNumber);
 }
 
-bool read_stock(const std::string& text, control::StockBlock& stock, std::string& error) {
-  const auto& workspace = board::sherline_suzuki::kRig.workspace_mm;
+bool read_stock(const std::array<double, 3>& workspace, const std::string& text, control::StockBlock& stock,
+                std::string& error) {
   stock = {{0.0, 0.0, 0.0}, {workspace[0], workspace[1], workspace[2]}};
   if (text.empty()) {
     return true;
@@ -119,7 +129,7 @@ bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& 
   offset.home_world_mm = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
   offset.tool_stick_out_mm = o.stick_out;
   offset.reference_stick_out_mm = o.reference_stick_out;
-  if (!read_stock(o.stock_text, stock, error) || (!o.report_path.empty() && !probe_writable(o.report_path, error))) {
+  if (!read_stock(o.config.facts.workspace_mm, o.stock_text, stock, error) || (!o.report_path.empty() && !probe_writable(o.report_path, error))) {
     return false;
   }
   if (!board::sherline_suzuki::is_haptic_link_name(o.haptic)) {
@@ -131,6 +141,33 @@ bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& 
     return false;
   }
   return true;
+}
+
+bool apply_rig_config(const CLI::App& app, RigOptions& o, std::string& error) {
+  if (!o.config_path.empty() && !board::sherline_suzuki::read_rig_config(o.config_path, o.config, error)) {
+    return false;
+  }
+  const board::sherline_suzuki::RigConfig& c = o.config;
+  const bool file = !o.config_path.empty();
+  if (app.count("--serial") == 0) o.serial_path = c.serial_port;
+  if (app.count("--haptic") == 0) o.haptic = c.haptic_link;
+  if (app.count("--priority") == 0 && file) o.priority = c.cycle_priority;
+  if (app.count("--cpu") == 0 && file) o.cpu = c.cycle_cpu;
+  if (app.count("--work-offset") == 0 && file) {
+    char text[96];
+    std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g", c.work_offset_mm[0], c.work_offset_mm[1], c.work_offset_mm[2]);
+    o.offset_text = text;
+  }
+  // Always below the cycle; without a file, 10 below it as before there was one.
+  o.machine_priority = file ? std::min(c.machine_priority, o.priority - 1) : std::max(1, o.priority - 10);
+  if (o.tables_path.empty()) {
+    error = "--tables: the part's .stbl is required";
+  } else if (o.serial_path.empty()) {
+    error = "--serial: the CY545's serial port is required (or machine.serial_port in the --config file)";
+  } else if (o.haptic.empty()) {
+    error = "--haptic: the haptic link is required (or haptic.link in the --config file)";
+  }
+  return error.empty();
 }
 
 }  // namespace stencil::app

@@ -6,6 +6,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "board/sherline_suzuki/rig_config.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/core/control/commanded_stock.hpp"
 #include "firmware/programs/display_option.hpp"
@@ -13,11 +14,15 @@
 namespace stencil::app {
 
 struct RigOptions {
+  std::string config_path;    // --config: the rig's file (empty: the compiled-in Sherline/Suzuki rig)
+  bool config_keys = false;   // --config-keys: print every key of the file and exit
+  board::sherline_suzuki::RigConfig config;  // the file's (or the defaults), with the command line's overrides
   std::string tables_path;
   std::string serial_path;
   std::string haptic;         // pio:/dev/uioN or can:IFACE
   bool require_rt = false;
   int priority = 80;
+  int machine_priority = 70;  // the machine thread's, below the cycle's (the file's threads.machine_priority)
   int cpu = -1;
   std::string offset_text;    // default: the rig's home (add_rig_options)
   double stick_out = 0.0;
@@ -32,6 +37,11 @@ struct RigOptions {
 };
 
 void add_rig_options(CLI::App& app, RigOptions& options);
+
+// After parsing: the configuration file read and checked (when --config names one), then the command
+// line's --serial, --haptic, --priority, --cpu and --work-offset over it; without a file, --serial and
+// --haptic must be given. False with the message (the file, the line, the key) for the terminal.
+[[nodiscard]] bool apply_rig_config(const CLI::App& app, RigOptions& options, std::string& error);
 
 // After parsing: the options checked and read into the job's work offset and stock block (the
 // report's path found writable). False with the message for the terminal.

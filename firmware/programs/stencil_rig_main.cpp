@@ -16,6 +16,7 @@
 #include "board/sherline_suzuki/rig_devices.hpp"
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "board/sherline_suzuki/rig_report.hpp"
+#include "board/sherline_suzuki/table_fit.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/rig_options.hpp"
 #include "firmware/programs/table_file.hpp"
@@ -61,6 +62,7 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
                   std::string& error) {
   request.program = "stencil-rig";
   request.path = o.journal_path;
+  request.folder = o.config.output_folder;
   request.none = o.no_journal;
   request.resume_path = o.resume_path;
   request.start.tables_crc32 = part.header.crc32;
@@ -69,7 +71,7 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
   if (!o.resume_path.empty()) {
     journal::JobHistory history;
     if (!journal::read_job_history(o.resume_path, part.header.crc32, part.header.triangle_count,
-                                   board::sherline_suzuki::rig_frames(job.offset), {}, history, error)) {
+                                   board::sherline_suzuki::rig_frames(job.offset, job.facts), {}, history, error)) {
       error = "--resume: " + error;
       return false;
     }
@@ -94,18 +96,16 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
   return true;
 }
 
-// The machine thread runs SCHED_FIFO 10 below the cycle (which always preempts it) and above the
+// The machine thread runs SCHED_FIFO below the cycle (which always preempts it) and above the
 // records thread, which stays SCHED_OTHER with the journal's writes and fsyncs: the machine's
 // updates keep their deadlines whatever the journal's disk does. Refused: it says so and runs on.
 // Nothing turns the spindle on unattended: once homed, the operator types 'start' at the terminal.
-void wire_operator(RigJob& job, int priority, app::TerminalCommands& terminal) {
+void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& terminal) {
   job.interrupted = &interrupted;
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
   job.operator_command = [&terminal] { return terminal.command_typed(); };
-  job.prepare_machine_thread = [priority] {
-    constexpr int kBelowTheCycle = 10;
-    const app::ThreadPriority got =
-        app::run_this_thread_fifo(priority > kBelowTheCycle ? priority - kBelowTheCycle : 1, "the machine thread");
+  job.prepare_machine_thread = [machine_priority] {
+    const app::ThreadPriority got = app::run_this_thread_fifo(machine_priority, "the machine thread");
     if (!got.message.empty()) {
       std::fprintf(stderr, "stencil-rig: %s\n", got.message.c_str());
     }
@@ -188,13 +188,28 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
   }
+  if (o.config_keys) {
+    std::printf("%s", board::sherline_suzuki::describe_rig_config_keys().c_str());
+    return 0;
+  }
   RigJob job;
   std::string error;
   std::vector<unsigned char> bytes;
   tables::PartTables part{};
-  if (!app::check_rig_options(o, job.offset, job.stock, error) || !app::load_table_file(o.tables_path, bytes, part, error)) {
+  if (!app::apply_rig_config(app, o, error) || !app::check_rig_options(o, job.offset, job.stock, error) ||
+      !app::load_table_file(o.tables_path, bytes, part, error)) {
     return fail(kExitBadInput, error);
   }
+  job.facts = o.config.facts;
+  const board::sherline_suzuki::TableFitJob fit{
+      {job.offset.home_world_mm.x(), job.offset.home_world_mm.y(), job.offset.home_world_mm.z()},
+      job.offset.tool_stick_out_mm, job.offset.reference_stick_out_mm};
+  if (!board::sherline_suzuki::check_tables_fit(part.header, o.tables_path, job.facts, fit, error)) {
+    return fail(kExitBadInput, error);
+  }
+  job.overrun_limit = job.facts.overrun_limit;
+  job.stale_periods = job.facts.stale_periods;
+  job.start_held = job.facts.start_held;
   std::printf("stencil-rig: tables %s: %u points, %u triangles\n", o.tables_path.c_str(), part.point_count(),
               part.triangle_count());
   const app::RtReadiness readiness = app::check_rt_readiness(bytes.size() + (64U << 20), o.priority);
@@ -203,7 +218,7 @@ int main(int argc, char** argv) {
     return fail(kExitNotStarted, "--require-rt: this host has no PREEMPT_RT kernel or may not use SCHED_FIFO");
   }
   board::sherline_suzuki::RigDevices devices;
-  if (!board::sherline_suzuki::open_rig_devices(o.serial_path, o.haptic, devices, [](const std::string& note) {
+  if (!board::sherline_suzuki::open_rig_devices(job.facts, o.serial_path, o.haptic, devices, [](const std::string& note) {
         std::printf("stencil-rig: %s\n", note.c_str());
       }, error)) {
     return fail(kExitNotStarted, error);
@@ -242,7 +257,7 @@ int main(int argc, char** argv) {
   job.resume_bytes = request.resume_bytes;
   job.duration_s = o.duration_s;
   app::TerminalCommands terminal;
-  wire_operator(job, o.priority, terminal);
+  wire_operator(job, o.machine_priority, terminal);
   std::printf("stencil-rig: homing the mill (Ctrl-C stops it); the spindle starts only once you type 'start'\n");
   std::fflush(stdout);
   const RigResult result = board::sherline_suzuki::run_rig(

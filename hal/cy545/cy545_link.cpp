@@ -540,14 +540,17 @@ MachineResult Cy545Link::home(MonotonicNs deadline_ns) {
   if (state_ == MachineState::Closed || state_ == MachineState::Open) {
     return refuse(MachineRefusal::NotHomed);
   }
+  if (!is_permutation(config_.motion.homing_order)) {
+    std::snprintf(last_error_, sizeof last_error_, "homing refused: the homing order names each axis once");
+    return refuse(MachineRefusal::BadTarget);
+  }
   if (deadline_ns - clock_.now_ns() < homing_bound_ns()) {
     std::snprintf(last_error_, sizeof last_error_, "homing refused: %.0f s given, it can take up to %.0f s",
                   static_cast<double>(deadline_ns - clock_.now_ns()) / 1e9, static_cast<double>(homing_bound_ns()) / 1e9);
     return refuse(MachineRefusal::DeadlineTooShort);  // nothing sent: homing could outlast the bound
   }
-  // Z first: after a crash or a stop mid-cut the tool may stand in the stock, and only raising it
-  // first takes it out without ploughing sideways through the work.
-  for (const std::size_t axis : {std::size_t{2}, std::size_t{0}, std::size_t{1}}) {
+  // In the configured order, Z first (the configuration refuses any other: Cy545Motion::homing_order).
+  for (const std::uint8_t axis : config_.motion.homing_order) {
     if (!home_axis(axis, deadline_ns)) {
       if (fault_ == MachineFault::None && abort_asked()) {
         return aborted(deadline_ns);

@@ -57,6 +57,9 @@ struct Cy545Motion {
   std::int32_t homing_slack_steps;
   std::int32_t homing_travel_steps;     // the longest approach of one axis
   std::int32_t home_switch_zone_steps;  // the switch's closed zone: a switch still closed this far out is miswired
+  // The axes in the order they home (0 x, 1 y, 2 z). Z first: after a crash or a stop mid-cut the tool
+  // may stand in the stock, and only raising it first takes it out without ploughing sideways.
+  std::array<std::uint8_t, 3> homing_order;
 };
 
 // The driver's configuration: the rig's wiring and motion (given), and the driver's own timing.

@@ -30,6 +30,8 @@ struct Mmc4sWiring {
   // address (the thesis's table 5-1: output ports 0-3 are "motor/driver addresses"), one select.
   // Measure it at commissioning: select X, then Y, step, and see whether X moves.
   bool channel_lines_latch_data;
+
+  bool operator==(const Mmc4sWiring&) const = default;
 };
 
 }  // namespace stencil::hal::cy545

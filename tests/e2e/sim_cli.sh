@@ -14,6 +14,7 @@ if [ "$#" -ne 3 ]; then
 fi
 case_name=$1 sim=$2 work_root=$3
 rig="$(dirname "$sim")/stencil-rig"
+repo="$(cd "$(dirname "$0")/../.." && pwd)"
 
 failures=0
 status=0
@@ -702,6 +703,50 @@ case_refuses_an_unknown_pattern() {
   run_sim --fast --pattern spiral
   expect_status 2
   expect_stderr "spiral" "the pattern it does not know"
+}
+
+# The rig's configuration file: each bad file refused with the file, the line and the key (or both
+# numbers), exit status 2, before anything is opened (nothing printed about the tables, the host or
+# the devices; the serial port named in the file is a FIFO nobody reads, which an open would block on).
+config_with() {  # KEY LINE: the example with the line starting "KEY =" replaced ("" removes it)
+  awk -v key="$1" -v line="$2" 'index($0, key " =") == 1 && !done { done = 1; if (line != "") print line; next } { print }' \
+    "$repo/board/sherline_suzuki/rig.toml" >rig.toml
+  chmod 600 rig.toml
+}
+refused_config() {  # PATTERN WHAT [ARGS...]
+  local pattern=$1 what=$2
+  shift 2
+  run_rig --config rig.toml --tables part.stbl "$@"
+  expect_status 2
+  expect_stderr "$pattern" "$what"
+  [ ! -s stdout.txt ] || fail "$what: something ran before the refusal: $(head -n 1 stdout.txt)"
+}
+case_rig_refuses_a_bad_configuration() {
+  mkdir -p parts && "$(dirname "$sim")/stencil-sample-parts" parts >/dev/null || fail "stencil-sample-parts failed"
+  "$(dirname "$sim")/stencil-tablegen" parts/hex_prism.stl -o part.stbl --tool ball:d=3 --quiet 2>/dev/null ||
+    fail "stencil-tablegen failed"
+  mkfifo port
+  config_with serial_port "serial_port = \"$PWD/port\""
+  cp rig.toml good.toml
+  config_with serial_baud $'serial_baud = 57600\nsteps_per_inch = 16000'
+  refused_config "rig.toml:12: unknown key 'machine.steps_per_inch'" "the unknown key with its line"
+  config_with update_hz "update_hz = 0.5"
+  refused_config "rig.toml:[0-9]+: machine.update_hz: 0.5 is out of range: expected a number from 1 to 200" "the range"
+  config_with force_limit_n "force_limit_n = 50.0"
+  refused_config "rig.toml:[0-9]+: haptic.force_limit_n: 50 is out of range: expected a number from 0.5 to 5 \(N, at most the board's 5 N" \
+    "the force ceiling no file raises"
+  config_with serial_port ""
+  refused_config "rig.toml: missing the key 'machine.serial_port'" "the missing serial port"
+  install -m 666 good.toml rig.toml
+  refused_config "rig.toml: writable by other users \(mode 0666\)" "the world-writable file"
+  install -m 600 good.toml rig.toml && sed -i 's/^travel_mm = \[50.0, 25.0, 25.0\]/travel_mm = [20.0, 25.0, 25.0]/' rig.toml
+  grep -q "^travel_mm = \[20.0" rig.toml || fail "the travel could not be set"
+  refused_config "part.stbl: the part spans x [0-9.]+ to [0-9.]+ mm; the configured travel reaches x 30 to 50 mm" \
+    "the part outside the configured travel, both numbers"
+  install -m 600 good.toml rig.toml && : >not_a_tty
+  run_rig --config rig.toml --tables part.stbl --serial not_a_tty
+  expect_status 3
+  expect_stderr "not_a_tty: not a serial port" "the command line's port over the file's"
 }
 
 # The rig program on a machine without the rig: it checks what it can and says what is missing.

@@ -35,7 +35,7 @@ bool open_job_journal(const JobJournalRequest& request, JournalWriter& writer, s
     localtime_r(&seconds, &local);
     char stamp[32];
     std::strftime(stamp, sizeof stamp, "-%Y%m%d-%H%M%S.journal", &local);
-    path = request.program + stamp;
+    path = (request.folder.empty() ? std::string() : request.folder + "/") + request.program + stamp;
   }
   JournalStart start = request.start;
   start.unix_time_ns = now_ns;

@@ -13,7 +13,8 @@ namespace stencil::journal {
 
 struct JobJournalRequest {
   std::string program;       // "stencil-sim", "stencil-rig": the Start/Resume record's and the default name's
-  std::string path;          // --journal; empty: <program>-YYYYMMDD-HHMMSS.journal here, at the start time
+  std::string path;          // --journal; empty: <program>-YYYYMMDD-HHMMSS.journal in `folder`, at the start time
+  std::string folder;        // the default name's folder (empty: the current one)
   bool none = false;         // --no-journal
   std::string resume_path;   // --resume: carry on in this file from its first resume_bytes
   std::size_t resume_bytes = 0;

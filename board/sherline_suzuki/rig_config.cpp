@@ -1,0 +1,450 @@
+#include "board/sherline_suzuki/rig_config.hpp"
+
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <sstream>
+
+// toml++ header-only, without exceptions: a parse error is a value (its description and line).
+#define TOML_EXCEPTIONS 0
+#include <toml++/toml.h>
+
+namespace stencil::board::sherline_suzuki {
+namespace {
+
+enum class Kind : std::uint8_t { Real, Integer, Flag, Text, Reals3, Integers3, Flags3 };
+
+struct Value {
+  std::array<double, 3> n{};
+  std::array<bool, 3> b{};
+  std::string text;
+};
+
+// One key: its type, the range of every number in it, whether the file must have it, its unit and
+// meaning, where it goes, and (when the range is not all) a check of its own: null, or what was expected.
+struct Key {
+  const char* name;
+  Kind kind;
+  double low, high;
+  bool required;
+  const char* meaning;
+  void (*apply)(RigConfig&, const Value&);
+  const char* (*check)(const Value&) = nullptr;
+};
+
+std::array<std::uint8_t, 3> bytes3(const Value& v) {
+  return {static_cast<std::uint8_t>(v.n[0]), static_cast<std::uint8_t>(v.n[1]), static_cast<std::uint8_t>(v.n[2])};
+}
+constexpr double kNs = 1e6;  // nanoseconds per millisecond
+
+const char* one_resolution(const Value& v) {
+  return v.n[0] == v.n[1] && v.n[1] == v.n[2]
+             ? nullptr
+             : "the same steps per mm on every axis (the frames and the planner take one resolution for all three)";
+}
+const char* unit_signs(const Value& v) {
+  for (const double sign : v.n) {
+    if (sign != 1.0 && sign != -1.0) return "1 or -1 per axis";
+  }
+  return nullptr;
+}
+const char* z_first(const Value& v) {
+  const std::string& t = v.text;
+  const bool permutation = t.size() == 3 && t.find('x') != std::string::npos && t.find('y') != std::string::npos &&
+                           t.find('z') != std::string::npos;
+  return permutation && t[0] == 'z' ? nullptr
+                                    : "\"zxy\" or \"zyx\": each axis once, Z first (a tool left in the stock leaves it "
+                                      "upwards, not through the work)";
+}
+const char* haptic_link_name(const Value& v) {
+  return (v.text.rfind("pio:", 0) == 0 || v.text.rfind("can:", 0) == 0) && v.text.size() > 4 ? nullptr
+                                                                                              : "pio:/dev/uioN or can:IFACE";
+}
+const char* device_path(const Value& v) {
+  return v.text.size() > 1 && v.text[0] == '/' ? nullptr : "an absolute device path, e.g. /dev/ttyS0";
+}
+const char* distinct_channels(const Value& v) {
+  return v.n[0] != v.n[1] && v.n[1] != v.n[2] && v.n[0] != v.n[2] ? nullptr : "a different channel per axis";
+}
+
+// clang-format off
+const Key kKeys[] = {
+  // [machine]: the mill (Sherline 3-axis) and its CY545 on the MMC-4S board, over RS-232.
+  {"machine.serial_port", Kind::Text, 0, 0, true, "the CY545's RS-232 port",
+   [](RigConfig& c, const Value& v) { c.serial_port = v.text; }, device_path},
+  {"machine.serial_baud", Kind::Integer, 300, 57600, true, "baud, 8N1; the CY545 finds the rate itself",
+   [](RigConfig& c, const Value& v) { c.facts.serial_baud = static_cast<std::uint32_t>(v.n[0]); }},
+  {"machine.steps_per_mm", Kind::Reals3, 1, 100000, true, "motor steps per mm, x y z",
+   [](RigConfig& c, const Value& v) { c.facts.steps_per_mm = v.n[0]; }, one_resolution},
+  {"machine.axis_sign", Kind::Integers3, -1, 1, true,
+   "x y z: +1 when machine steps count along the part's axis, -1 against it, as where the table moves under the tool",
+   [](RigConfig& c, const Value& v) { c.facts.machine_sign = {static_cast<int>(v.n[0]), static_cast<int>(v.n[1]), static_cast<int>(v.n[2])}; },
+   unit_signs},
+  {"machine.travel_mm", Kind::Reals3, 1, 2000, true, "mm of workspace per axis from the home switch's edge",
+   [](RigConfig& c, const Value& v) { c.facts.workspace_mm = v.n; }},
+  {"machine.backlash_mm", Kind::Reals3, 0, 5, true, "mm of play per axis, a whole number of steps",
+   [](RigConfig& c, const Value& v) { c.facts.backlash_mm = v.n; }},
+  {"machine.max_speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s per axis",
+   [](RigConfig& c, const Value& v) { c.facts.max_speed_mm_per_s = v.n[0]; }},
+  {"machine.step_rate_steps_per_s", Kind::Real, 1, 27000, true, "steps/s, the CY545's rate (27000 at most)",
+   [](RigConfig& c, const Value& v) { c.facts.step_rate_steps_per_s = v.n[0]; }},
+  {"machine.update_hz", Kind::Real, 1, 200, true, "machine updates per second over the serial line",
+   [](RigConfig& c, const Value& v) { c.facts.machine_update_hz = v.n[0]; }},
+  {"machine.home_overtravel_mm", Kind::Real, 0, 50, true, "mm from the switch's edge down to the low hard stop",
+   [](RigConfig& c, const Value& v) { c.facts.home_overtravel_mm = v.n[0]; }},
+  {"machine.far_overtravel_mm", Kind::Real, 0, 50, true, "mm past the workspace up to the high hard stop",
+   [](RigConfig& c, const Value& v) { c.facts.far_overtravel_mm = v.n[0]; }},
+  {"machine.home_switch_edge_mm", Kind::Real, -50, 50, true, "machine mm at which the home switch opens",
+   [](RigConfig& c, const Value& v) { c.facts.home_switch_edge_mm = v.n[0]; }},
+  {"machine.watchdog_relay_timeout_ms", Kind::Real, 50, 10000, true, "ms without a heartbeat before the relay drops",
+   [](RigConfig& c, const Value& v) { c.facts.watchdog_relay_timeout_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }},
+  // [machine.homing]
+  {"machine.homing.order", Kind::Text, 0, 0, true, "the axes in homing order",
+   [](RigConfig& c, const Value& v) {
+     for (std::size_t i = 0; i < 3; ++i) c.facts.homing_order[i] = static_cast<std::uint8_t>(v.text[i] - 'x');
+   }, z_first},
+  {"machine.homing.speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s of the approach",
+   [](RigConfig& c, const Value& v) { c.facts.homing_speed_mm_per_s = v.n[0]; }},
+  {"machine.homing.slow_speed_mm_per_s", Kind::Real, 0.001, 100, true, "mm/s of the edge-finding steps",
+   [](RigConfig& c, const Value& v) { c.facts.homing_slow_speed_mm_per_s = v.n[0]; }},
+  {"machine.homing.chunk_mm", Kind::Real, 0.001, 10, true, "mm an approach may run into the switch",
+   [](RigConfig& c, const Value& v) { c.facts.homing_chunk_mm = v.n[0]; }},
+  {"machine.homing.slack_mm", Kind::Real, 0, 10, true, "mm the departure may turn before the axis moves",
+   [](RigConfig& c, const Value& v) { c.facts.homing_slack_mm = v.n[0]; }},
+  {"machine.homing.travel_mm", Kind::Real, 1, 5000, true, "mm of the longest approach (more than the whole travel)",
+   [](RigConfig& c, const Value& v) { c.facts.homing_travel_mm = v.n[0]; }},
+  {"machine.homing.switch_zone_mm", Kind::Real, 0.1, 100, true, "mm: a switch still closed this far out is miswired",
+   [](RigConfig& c, const Value& v) { c.facts.home_switch_zone_mm = v.n[0]; }},
+  // [machine.board]: the MMC-4S's wiring.
+  {"machine.board.motor_channel", Kind::Integers3, 0, 3, true, "output-mux port of the x y z motors",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.motor_channel = bytes3(v); }, distinct_channels},
+  {"machine.board.home_input", Kind::Integers3, 0, 7, true, "input-mux port of the x y z home switches",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_input = bytes3(v); }, distinct_channels},
+  {"machine.board.spindle_output", Kind::Integer, 0, 7, true, "general-purpose output that runs the spindle",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.spindle_output = static_cast<std::uint8_t>(v.n[0]); }},
+  {"machine.board.heartbeat_output", Kind::Integer, -1, 7, true, "output the watchdog relay watches, -1: no relay",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_output = static_cast<int>(v.n[0]); }},
+  {"machine.board.heartbeat_period_ms", Kind::Real, 10, 5000, true, "ms per heartbeat (toggled every half)",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_period_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }},
+  {"machine.board.home_switch_closed_level", Kind::Flags3, 0, 0, true, "x y z: the level read while the switch is closed",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_switch_closed_level = v.b; }},
+  {"machine.board.channel_lines_latch_data", Kind::Flag, 0, 0, true, "true: each channel line latches its data bit",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.channel_lines_latch_data = v.b[0]; }},
+  // [haptic]: the device (Suzuki 5-DOF) and the cycle.
+  {"haptic.link", Kind::Text, 0, 0, true, "the device's link",
+   [](RigConfig& c, const Value& v) { c.haptic_link = v.text; }, haptic_link_name},
+  {"haptic.reach_mm", Kind::Reals3, 10, 5000, true, "device mm of reach, x y z",
+   [](RigConfig& c, const Value& v) { c.facts.haptic_workspace_mm = v.n; }},
+  {"haptic.reach_margin_mm", Kind::Real, 0, 500, true, "device mm outside the reach still taken as a sample",
+   [](RigConfig& c, const Value& v) { c.facts.device_reach_margin_mm = v.n[0]; }},
+  {"haptic.device_mm_per_machine_mm", Kind::Real, 0.1, 100, true, "the haptic-to-machine scale",
+   [](RigConfig& c, const Value& v) { c.facts.haptic_to_machine_scale = v.n[0]; }},
+  {"haptic.force_limit_n", Kind::Real, 0.5, 5, true, "N, at most the board's 5 N: no file raises it",
+   [](RigConfig& c, const Value& v) { c.facts.force_limit_n = v.n[0]; }},
+  {"haptic.torque_limit_nmm", Kind::Real, 1, 200, true, "N mm, the two displayed torques",
+   [](RigConfig& c, const Value& v) { c.facts.torque_limit_nmm = v.n[0]; }},
+  {"haptic.angle_limit_rad", Kind::Real, 0.1, 3.2, true, "rad, the two sensed angles",
+   [](RigConfig& c, const Value& v) { c.facts.angle_limit_rad = v.n[0]; }},
+  {"haptic.rate_hz", Kind::Real, 250, 4000, true, "the cycle's rate",
+   [](RigConfig& c, const Value& v) { c.facts.haptic_rate_hz = v.n[0]; }},
+  // [controller]
+  {"controller.virtual_tool_speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s, at most the mill's",
+   [](RigConfig& c, const Value& v) { c.facts.virtual_tool_speed_mm_per_s = v.n[0]; }},
+  {"controller.standoff_mm", Kind::Real, 0, 1, true, "mm the virtual tool keeps clear of the part",
+   [](RigConfig& c, const Value& v) { c.facts.machine_standoff_mm = v.n[0]; }},
+  {"controller.stock_model_cell_mm", Kind::Real, 0.01, 1, true, "mm cells of the model of the machined stock",
+   [](RigConfig& c, const Value& v) { c.facts.stock_model_cell_mm = v.n[0]; }},
+  {"controller.overrun_limit", Kind::Integer, 1, 100, true, "overruns in a row before a safe state",
+   [](RigConfig& c, const Value& v) { c.facts.overrun_limit = static_cast<int>(v.n[0]); }},
+  {"controller.stale_periods", Kind::Integer, 1, 100, true, "periods without a fresh sample before a safe state",
+   [](RigConfig& c, const Value& v) { c.facts.stale_periods = static_cast<int>(v.n[0]); }},
+  {"controller.start_held", Kind::Flag, 0, 0, true, "start held until the hand is still near the tool",
+   [](RigConfig& c, const Value& v) { c.facts.start_held = v.b[0]; }},
+  // [threads]
+  {"threads.cycle_cpu", Kind::Integer, -1, 1023, false, "CPU the cycle is pinned to, -1: none",
+   [](RigConfig& c, const Value& v) { c.cycle_cpu = static_cast<int>(v.n[0]); }},
+  {"threads.cycle_priority", Kind::Integer, 2, 99, true, "the cycle's SCHED_FIFO priority",
+   [](RigConfig& c, const Value& v) { c.cycle_priority = static_cast<int>(v.n[0]); }},
+  {"threads.machine_priority", Kind::Integer, 1, 98, true, "the machine thread's SCHED_FIFO priority, below the cycle's",
+   [](RigConfig& c, const Value& v) { c.machine_priority = static_cast<int>(v.n[0]); }},
+  // [job]
+  {"job.work_offset_mm", Kind::Reals3, -10000, 10000, true, "x y z: the tool tip in the part's frame at home",
+   [](RigConfig& c, const Value& v) { c.work_offset_mm = v.n; }},
+  {"job.output_folder", Kind::Text, 0, 0, false, "folder for journals; empty or absent: the current folder",
+   [](RigConfig& c, const Value& v) { c.output_folder = v.text; }},
+};
+// clang-format on
+
+const char* kind_name(Kind kind) {
+  switch (kind) {
+    case Kind::Real: return "a number";
+    case Kind::Integer: return "an integer";
+    case Kind::Flag: return "true or false";
+    case Kind::Text: return "a quoted string";
+    case Kind::Reals3: return "an array of 3 numbers";
+    case Kind::Integers3: return "an array of 3 integers";
+    case Kind::Flags3: return "an array of 3 true/false";
+  }
+  return "?";
+}
+
+std::string number_text(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%g", value);
+  return text;
+}
+
+std::string expected_of(const Key& key) {
+  std::string text = kind_name(key.kind);
+  if (key.kind != Kind::Text && key.kind != Kind::Flag && key.kind != Kind::Flags3) {
+    text += " from " + number_text(key.low) + " to " + number_text(key.high);
+  }
+  return text + " (" + key.meaning + ")";
+}
+
+// One scalar of `key`'s type into `number`/`flag`/`text`: false when the node is of another type.
+bool read_scalar(const toml::node& node, Kind kind, double& number, bool& flag, std::string& text) {
+  switch (kind) {
+    case Kind::Real:
+    case Kind::Reals3:
+      if (!node.is_number()) return false;
+      number = node.value<double>().value_or(0.0);
+      return true;
+    case Kind::Integer:
+    case Kind::Integers3:
+      if (!node.is_integer()) return false;
+      number = static_cast<double>(node.value<std::int64_t>().value_or(0));
+      return true;
+    case Kind::Flag:
+    case Kind::Flags3:
+      if (!node.is_boolean()) return false;
+      flag = node.value<bool>().value_or(false);
+      return true;
+    case Kind::Text:
+      if (!node.is_string()) return false;
+      text = node.value<std::string>().value_or("");
+      return true;
+  }
+  return false;
+}
+
+// The node as `key`'s value, its type and range checked: "" or what is wrong.
+std::string read_value(const toml::node& node, const Key& key, Value& value) {
+  const bool triple = key.kind == Kind::Reals3 || key.kind == Kind::Integers3 || key.kind == Kind::Flags3;
+  const toml::array* array = node.as_array();
+  if (triple != (array != nullptr) || (triple && array->size() != 3)) {
+    return "expected " + expected_of(key);
+  }
+  for (std::size_t i = 0; i < (triple ? 3U : 1U); ++i) {
+    const toml::node& element = triple ? *array->get(i) : node;
+    if (!read_scalar(element, key.kind, value.n[i], value.b[i], value.text)) {
+      return "expected " + expected_of(key);
+    }
+    const bool numeric = key.kind != Kind::Text && key.kind != Kind::Flag && key.kind != Kind::Flags3;
+    if (numeric && !(value.n[i] >= key.low && value.n[i] <= key.high)) {
+      return number_text(value.n[i]) + " is out of range: expected " + expected_of(key);
+    }
+  }
+  const char* wrong = key.check == nullptr ? nullptr : key.check(value);
+  return wrong == nullptr ? "" : "expected " + std::string(wrong);
+}
+
+const Key* find_key(const std::string& name) {
+  for (const Key& key : kKeys) {
+    if (name == key.name) return &key;
+  }
+  return nullptr;
+}
+
+bool is_section(const std::string& name) {
+  const std::string prefix = name + ".";
+  for (const Key& key : kKeys) {
+    if (std::string(key.name).rfind(prefix, 0) == 0) return true;
+  }
+  return false;
+}
+
+struct Reading {
+  const std::string& source;
+  RigConfig& config;
+  std::map<std::string, long> lines;  // every key read, and its line
+  std::string error;
+};
+
+std::string at(const std::string& source, long line) { return source + ":" + std::to_string(line) + ": "; }
+
+bool read_table(const toml::table& table, const std::string& prefix, Reading& reading) {
+  for (auto&& [name_key, node] : table) {
+    const std::string name = prefix + std::string(name_key.str());
+    const long line = static_cast<long>(node.source().begin.line);
+    if (node.is_table() && is_section(name)) {
+      if (!read_table(*node.as_table(), name + ".", reading)) return false;
+      continue;
+    }
+    const Key* key = find_key(name);
+    if (key == nullptr) {
+      reading.error = at(reading.source, line) + "unknown key '" + name +
+                      "' (every key is in board/sherline_suzuki/rig.toml and stencil-rig --config-keys)";
+      return false;
+    }
+    Value value;
+    const std::string wrong = read_value(node, *key, value);
+    if (!wrong.empty()) {
+      reading.error = at(reading.source, line) + name + ": " + wrong;
+      return false;
+    }
+    key->apply(reading.config, value);
+    reading.lines[name] = line;
+  }
+  return true;
+}
+
+// Facts that contradict each other, or a ceiling of the hardware: "" or the message.
+std::string contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  const RigFacts& f = c.facts;
+  const auto where = [&](const char* name) {
+    const auto found = lines.find(name);
+    return found == lines.end() ? source + ": " : at(source, found->second);
+  };
+  const double needed_rate = f.max_speed_mm_per_s * f.steps_per_mm;
+  if (needed_rate > f.step_rate_steps_per_s + 1e-9) {
+    return where("machine.max_speed_mm_per_s") + "machine.max_speed_mm_per_s " + number_text(f.max_speed_mm_per_s) +
+           " needs " + number_text(needed_rate) + " steps/s at " + number_text(f.steps_per_mm) +
+           " steps/mm, above machine.step_rate_steps_per_s " + number_text(f.step_rate_steps_per_s);
+  }
+  if (f.virtual_tool_speed_mm_per_s > f.max_speed_mm_per_s) {
+    return where("controller.virtual_tool_speed_mm_per_s") + "controller.virtual_tool_speed_mm_per_s " +
+           number_text(f.virtual_tool_speed_mm_per_s) + " is above machine.max_speed_mm_per_s " +
+           number_text(f.max_speed_mm_per_s) + ": the mill could not follow the tool";
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    const double steps = f.backlash_mm[axis] * f.steps_per_mm;
+    if (std::fabs(steps - std::round(steps)) > 1e-6) {
+      return where("machine.backlash_mm") + "machine.backlash_mm " + number_text(f.backlash_mm[axis]) + " on " +
+             static_cast<char>('x' + axis) + " is " + number_text(steps) + " steps: expected a whole number of steps";
+    }
+  }
+  if (f.machine_standoff_mm < standoff_needed_mm(f)) {
+    return where("controller.standoff_mm") + "controller.standoff_mm " + number_text(f.machine_standoff_mm) +
+           " is under the " + number_text(standoff_needed_mm(f)) + " mm the planner's fallback staircase needs at " +
+           number_text(f.steps_per_mm) + " steps/mm";
+  }
+  if (!motion::follow_fallback_fits(planner_limits(f))) {
+    return where("machine.update_hz") + "one machine update (machine.update_hz " + number_text(f.machine_update_hz) +
+           ") is too short for the planner's fallback staircase at machine.step_rate_steps_per_s " +
+           number_text(f.step_rate_steps_per_s);
+  }
+  return "";
+}
+
+std::string homing_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  const RigFacts& f = c.facts;
+  const auto where = [&](const char* name) {
+    const auto found = lines.find(name);
+    return found == lines.end() ? source + ": " : at(source, found->second);
+  };
+  if (f.homing_speed_mm_per_s >= f.max_speed_mm_per_s || f.homing_slow_speed_mm_per_s > f.homing_speed_mm_per_s) {
+    return where("machine.homing.speed_mm_per_s") + "machine.homing.speed_mm_per_s " +
+           number_text(f.homing_speed_mm_per_s) + ": expected below machine.max_speed_mm_per_s " +
+           number_text(f.max_speed_mm_per_s) + " and at least machine.homing.slow_speed_mm_per_s " +
+           number_text(f.homing_slow_speed_mm_per_s);
+  }
+  if (f.homing_slack_mm <= largest_backlash_mm(f)) {
+    return where("machine.homing.slack_mm") + "machine.homing.slack_mm " + number_text(f.homing_slack_mm) +
+           ": expected above the largest backlash, " + number_text(largest_backlash_mm(f)) + " mm";
+  }
+  if (f.home_switch_zone_mm <= f.home_overtravel_mm) {
+    return where("machine.homing.switch_zone_mm") + "machine.homing.switch_zone_mm " +
+           number_text(f.home_switch_zone_mm) + ": expected above machine.home_overtravel_mm " +
+           number_text(f.home_overtravel_mm);
+  }
+  for (int axis = 0; axis < 3; ++axis) {
+    const double whole = travel_max_mm(axis, f) - travel_min_mm(axis, f);
+    if (f.homing_travel_mm <= whole) {
+      return where("machine.homing.travel_mm") + "machine.homing.travel_mm " + number_text(f.homing_travel_mm) +
+             ": expected more than " + static_cast<char>('x' + axis) + "'s whole travel, " + number_text(whole) + " mm";
+    }
+  }
+  if (c.machine_priority >= c.cycle_priority) {
+    return where("threads.machine_priority") + "threads.machine_priority " + std::to_string(c.machine_priority) +
+           ": expected below threads.cycle_priority " + std::to_string(c.cycle_priority);
+  }
+  if (f.mmc4s.heartbeat_output == f.mmc4s.spindle_output) {
+    return where("machine.board.heartbeat_output") + "machine.board.heartbeat_output: expected another output than "
+           "the spindle's";
+  }
+  return "";
+}
+
+}  // namespace
+
+bool parse_rig_config(std::string_view text, const std::string& source, RigConfig& config, std::string& error) {
+  toml::parse_result parsed = toml::parse(text, source);
+  if (!parsed) {
+    error = at(source, static_cast<long>(parsed.error().source().begin.line)) + std::string(parsed.error().description());
+    return false;
+  }
+  RigConfig read = config;
+  Reading reading{source, read, {}, {}};
+  if (!read_table(parsed.table(), "", reading)) {
+    error = reading.error;
+    return false;
+  }
+  for (const Key& key : kKeys) {
+    if (key.required && reading.lines.count(key.name) == 0) {
+      error = source + ": missing the key '" + key.name + "': expected " + expected_of(key);
+      return false;
+    }
+  }
+  error = contradiction(read, reading.lines, source);
+  if (error.empty()) {
+    error = homing_contradiction(read, reading.lines, source);
+  }
+  if (!error.empty()) {
+    return false;
+  }
+  config = read;
+  return true;
+}
+
+bool read_rig_config(const std::string& path, RigConfig& config, std::string& error) {
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) {
+    error = path + ": no such configuration file";
+    return false;
+  }
+  if (status.st_uid != 0 && status.st_uid != ::geteuid()) {
+    error = path + ": owned by user " + std::to_string(status.st_uid) + ": expected this program's user (" +
+            std::to_string(::geteuid()) + ") or root, since the file decides where the tool goes";
+    return false;
+  }
+  if ((status.st_mode & (S_IWGRP | S_IWOTH)) != 0) {
+    char mode[8];
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(status.st_mode & 07777));
+    error = path + ": writable by other users (mode " + mode + "): expected writable by its owner only (chmod go-w " +
+            path + ")";
+    return false;
+  }
+  std::ifstream file(path, std::ios::binary);
+  std::stringstream text;
+  text << file.rdbuf();
+  if (!file) {
+    error = path + ": could not be read";
+    return false;
+  }
+  return parse_rig_config(text.str(), path, config, error);
+}
+
+std::string describe_rig_config_keys() {
+  std::string text;
+  for (const Key& key : kKeys) {
+    text += std::string(key.name) + (key.required ? "" : " (optional)") + ": " + expected_of(key) + "\n";
+  }
+  return text;
+}
+
+}  // namespace stencil::board::sherline_suzuki

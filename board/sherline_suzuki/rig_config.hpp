@@ -1,0 +1,41 @@
+// The rig in a configuration file (TOML, for example /etc/stencil/rig.toml): every fact of the rig
+// (rig_facts.hpp) and what the program needs to run it (its serial port, haptic link, threads, work
+// offset, output folder), read and checked before any device is opened. The shipped example,
+// board/sherline_suzuki/rig.toml, holds every key with its unit and range and equals the compiled-in
+// defaults (kRig).
+#pragma once
+
+#include <array>
+#include <string>
+#include <string_view>
+
+#include "board/sherline_suzuki/rig_facts.hpp"
+
+namespace stencil::board::sherline_suzuki {
+
+struct RigConfig {
+  RigFacts facts = kRig;
+  std::string serial_port;          // the CY545's RS-232 port, e.g. /dev/ttyS0
+  std::string haptic_link;          // pio:/dev/uioN or can:IFACE
+  int cycle_cpu = -1;               // -1: not pinned
+  int cycle_priority = 80;          // SCHED_FIFO
+  int machine_priority = 70;        // SCHED_FIFO, below the cycle (it always preempts the machine thread)
+  std::array<double, 3> work_offset_mm = kHomeWorldMm;  // the tool tip in the part's frame with the machine at home
+  std::string output_folder;        // where journals go by default ("": the current folder)
+};
+
+// Reads `text` (named `source` in messages) over the defaults in `config`. False with `error` naming
+// the source, the line, the key and what was expected: an unknown key, a missing required key, a
+// wrong type, a value out of its range or against the rig's hard ceilings (the force at most the
+// board's 5 N, the speed at most what the mill's steps allow), or facts that contradict each other.
+[[nodiscard]] bool parse_rig_config(std::string_view text, const std::string& source, RigConfig& config,
+                                    std::string& error);
+
+// The file at `path`: refused first when a user other than this process's own or root owns it or can
+// write to it (group- or world-writable), since what it says decides where a real tool goes.
+[[nodiscard]] bool read_rig_config(const std::string& path, RigConfig& config, std::string& error);
+
+// The allowed keys, one line each with type, unit and range (for --help and README).
+[[nodiscard]] std::string describe_rig_config_keys();
+
+}  // namespace stencil::board::sherline_suzuki
