@@ -69,6 +69,7 @@ class MillWiring final : public runtime::JobHooks {
   stencil::sim::SimulatedMill mill_;
   hal::MonotonicNs epoch_ns_;
   stencil::sim::cy545::FakeCy545 fake_;
+  hal::MonotonicNs relay_ns_;  // the watchdog relay's time (the mill's truth)
   std::optional<stencil::sim::cy545::FakeCy545Clock> fast_clock_;
   hal::posix_clock::MonotonicClock wall_clock_;
   stencil::sim::MachinedPart machined_;

@@ -17,6 +17,16 @@ namespace stencil::board::sim {
 
 namespace rig = board::sherline_suzuki;
 
+// The simulated rig: what the controller is configured with (stencil-sim --config: a rig's
+// configuration file; by default the compiled-in Sherline/Suzuki rig), where the tool tip is in the
+// world at home, and the simulated mill's truth (--mill-truth: the same file by default, another
+// where a test wants the configuration wrong against the mill).
+struct SimRig {
+  rig::RigFacts facts = rig::kRig;
+  std::array<double, 3> home_world_mm = rig::kHomeWorldMm;
+  rig::RigFacts mill_truth = rig::kRig;
+};
+
 // The frames: world = device / 10, device space [0,500]x[0,250]x[0,250]; the machine homes with the
 // tool at the workspace's far top corner (its X and Y switches at the table's travel end, Z at the
 // top), so every axis counts from there into the workspace.
@@ -47,33 +57,38 @@ inline constexpr std::uint32_t kBaud = rig::kRig.serial_baud;
 // The simulated rig's hardware watchdog relay: the rig's, on the rig's heartbeat output.
 inline constexpr hal::MonotonicNs kWatchdogRelayNs = rig::kRig.watchdog_relay_timeout_ns;
 
-// The simulated Sherline mill: the rig's steps, backlash, hard stops and home switches; it powers up in
-// mid-workspace with the slack on the negative side (as after a positive move), so that homing has a
-// way to go on every axis.
-inline constexpr stencil::sim::MillConfig kMillConfig = [] {
+// The simulated Sherline mill: the rig's steps, backlash, hard stops and home switches (`truth`: the
+// mill as it is, which a test may make differ from what the controller's configuration `believed`
+// says); it powers up in mid-workspace with the slack on the negative side (as after a positive
+// move), so that homing has a way to go on every axis. An axis whose configured sign disagrees with
+// the truth runs the other way from what the controller commands, as a motor wired backwards does.
+inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth, const rig::RigFacts& believed) {
   stencil::sim::MillConfig config{};
-  config.steps_per_mm = rig::kRig.steps_per_mm;
+  config.steps_per_mm = truth.steps_per_mm;
   for (int axis = 0; axis < rig::kAxisCount; ++axis) {
-    stencil::sim::MillAxisConfig& a = config.axes[static_cast<std::size_t>(axis)];
-    a.backlash_steps = rig::backlash_steps(axis);
-    a.travel_min_steps = rig::mm_to_steps(rig::travel_min_mm(axis));
-    a.travel_max_steps = rig::mm_to_steps(rig::travel_max_mm(axis));
-    a.home_switch_edge_steps = rig::mm_to_steps(rig::kRig.home_switch_edge_mm);
-    a.initial_position_steps = rig::mm_to_steps(rig::kRig.workspace_mm[static_cast<std::size_t>(axis)] / 2.0);
+    const auto a = static_cast<std::size_t>(axis);
+    stencil::sim::MillAxisConfig& c = config.axes[a];
+    c.backlash_steps = rig::backlash_steps(axis, truth);
+    c.travel_min_steps = rig::mm_to_steps(rig::travel_min_mm(axis, truth), truth);
+    c.travel_max_steps = rig::mm_to_steps(rig::travel_max_mm(axis, truth), truth);
+    c.home_switch_edge_steps = rig::mm_to_steps(truth.home_switch_edge_mm, truth);
+    c.initial_position_steps = rig::mm_to_steps(truth.workspace_mm[a] / 2.0, truth);
+    c.motor_direction = truth.machine_sign[a] == believed.machine_sign[a] ? 1 : -1;
   }
   return config;
-}();
+}
+inline constexpr stencil::sim::MillConfig kMillConfig = mill_config(rig::kRig, rig::kRig);
 
 // The MMC-4S board's wiring, for the fake CY545's board and the driver alike: the rig's.
 inline constexpr hal::cy545::Mmc4sWiring kMmc4sWiring = rig::kRig.mmc4s;
 
 // The CY545 driver as the simulation runs it: the rig's configuration, with these differences.
-inline constexpr hal::cy545::Cy545Config link_config(bool realtime) {
-  hal::cy545::Cy545Config config = rig::kCy545;
+inline constexpr hal::cy545::Cy545Config link_config(bool realtime, const rig::RigFacts& facts = rig::kRig) {
+  hal::cy545::Cy545Config config = rig::cy545_config(facts);
   // Homing at 25 times the rig's approach rate and 10 times its edge-finding rate: the simulated mill
   // has no inertia to overrun its switch with, and every job starts by homing from mid-travel.
-  config.motion.homing_rate = 25 * rig::kCy545.motion.homing_rate;
-  config.motion.homing_slow_rate = 10 * rig::kCy545.motion.homing_slow_rate;
+  config.motion.homing_rate = 25 * config.motion.homing_rate;
+  config.motion.homing_slow_rate = 10 * config.motion.homing_slow_rate;
   // The simulated rig takes the thesis's reading of the MMC-4S (an address latch: one select a change
   // of axis): the per-line reading's extra commands cost the mill much of its throughput (the demo
   // job: 0.93 % -> 5.4 % uncut). The driver is held to the per-line board by its own tests.
@@ -85,7 +100,7 @@ inline constexpr hal::cy545::Cy545Config link_config(bool realtime) {
   if (realtime) {
     // The fake answers from a thread on a host that is not real-time: a late reply is its scheduling,
     // so five times the driver's own bound.
-    config.reply_timeout_ns = 5 * rig::kCy545.reply_timeout_ns;
+    config.reply_timeout_ns = 5 * config.reply_timeout_ns;
   }
   return config;
 }

@@ -25,12 +25,19 @@
 #include "sim/mill/machined_part.hpp"
 
 namespace stencil::board::sim {
-// kPeriodNs, kUpdateNs, kModelCellMm, kPlannerLimits: sim_facts.hpp (the rig's).
+// The period, the update, the model's cells and the planner's limits: the configured rig's (sim_facts.hpp).
 
-motion::MachineFrames frames() {
+motion::MachineFrames frames(const SimRig& rig) {
   // Every axis counts into the workspace from its switch, so the world runs against all three.
-  return {kDeviceMmPerWorldMm, Eigen::Vector3d::Zero(),
-          Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]), rig::kRig.machine_sign, rig::kRig.steps_per_mm};
+  const rig::RigFacts& f = rig.facts;
+  return {f.haptic_to_machine_scale, Eigen::Vector3d::Zero(),
+          Eigen::Vector3d(rig.home_world_mm[0], rig.home_world_mm[1], rig.home_world_mm[2]), f.machine_sign, f.steps_per_mm};
+}
+
+motion::MachineFrames true_frames(const SimRig& rig) {
+  motion::MachineFrames truth = frames(rig);
+  truth.steps_per_mm = rig.mill_truth.steps_per_mm;
+  return truth;
 }
 
 stencil::sim::StockBox default_stock(const tables::PartTables& part) {
@@ -48,14 +55,13 @@ stencil::sim::StockBox default_stock(const tables::PartTables& part) {
           (high + margin + Eigen::Vector3d(0, 0, 1.0)).cwiseMin(workspace)};
 }
 
-control::ControllerConfig controller_config(bool realtime) {
-  // The world's workspace runs from 0 to home (its far top corner); the device's is ten times that.
-  const Eigen::Vector3d device_workspace_mm =
-      kDeviceMmPerWorldMm * Eigen::Vector3d(kHomeWorldMm[0], kHomeWorldMm[1], kHomeWorldMm[2]);
+control::ControllerConfig controller_config(bool realtime, const SimRig& rig) {
+  const rig::RigFacts& f = rig.facts;
+  const Eigen::Vector3d device_workspace_mm(f.haptic_workspace_mm[0], f.haptic_workspace_mm[1], f.haptic_workspace_mm[2]);
   // Overruns count in real time only: in virtual time lateness means nothing.
-  return runtime::controller_config({frames(), device_workspace_mm, rig::kRig.device_reach_margin_mm,
-                                     rig::kRig.force_limit_n, rig::kRig.torque_limit_nmm, 1.0 / rig::kRig.haptic_rate_hz,
-                                     kVirtualToolSpeedMmPerS, kStandoffMm, realtime});
+  return runtime::controller_config({frames(rig), device_workspace_mm, f.device_reach_margin_mm, f.force_limit_n,
+                                     f.torque_limit_nmm, 1.0 / f.haptic_rate_hz, f.virtual_tool_speed_mm_per_s,
+                                     f.machine_standoff_mm, realtime});
 }
 
 std::function<double(double, double)> touch_tip_of(const tables::PartTables& part, const stencil::sim::StockBox& stock) {
@@ -78,13 +84,13 @@ runtime::JobParts parts_of(const SimJob& job, MillWiring& mill, hal::HapticDevic
   parts.device = &device;
   parts.machine = &mill.link();
   parts.machine_clock = &mill.clock();
-  parts.controller = controller_config(realtime);
-  parts.planner = kPlannerLimits;
-  parts.period_ns = kPeriodNs;
-  parts.update_ns = kUpdateNs;
-  parts.shut_down_bound_ns = runtime::kUpdateBoundUpdates * kUpdateNs;
+  parts.controller = controller_config(realtime, job.rig);
+  parts.planner = rig::planner_limits(job.rig.facts);
+  parts.period_ns = rig::period_ns(job.rig.facts);
+  parts.update_ns = rig::update_ns(job.rig.facts);
+  parts.shut_down_bound_ns = runtime::kUpdateBoundUpdates * parts.update_ns;
   parts.stock = {job.stock.low_mm, job.stock.high_mm};
-  parts.model_cell_mm = kModelCellMm;
+  parts.model_cell_mm = job.rig.facts.stock_model_cell_mm;
   parts.journal = job.journal;
   parts.resume_from = job.resume_from;
   parts.resume_bytes = job.resume_bytes;
@@ -102,7 +108,7 @@ runtime::JobParts parts_of(const SimJob& job, MillWiring& mill, hal::HapticDevic
 SimResult run_virtual(const SimJob& job, runtime::Job& assembled, MillWiring& mill, SimulatedOperator& hand,
                       stencil::sim::ReplayHapticDevice& replay_device, SimResult& result,
                       std::chrono::steady_clock::time_point wall_start) {
-  FaultInjector fault(job.fault, hand.wiring(), mill.fake(), assembled.controller(), kPeriodNs);
+  FaultInjector fault(job.fault, hand.wiring(), mill.fake(), assembled.controller(), rig::period_ns(job.rig.facts));
   std::optional<JournalReplay> replay;
   if (job.replay != nullptr) {
     static const std::vector<control::CommandEvent> kNone;
@@ -141,7 +147,7 @@ SimResult run_threads(const SimJob& job, runtime::Job& assembled, MillWiring& mi
   runtime::JobHooks* const hooks[] = {&hand, &end, &mill};
   runtime::ThreadedRun options;
   options.safe_state_ends = runtime::SafeStateEnds::Any;
-  options.settle_ns = 2 * kUpdateNs;  // one more update, so a safe state reaches the mill (hold, then stop)
+  options.settle_ns = 2 * rig::update_ns(job.rig.facts);  // one more update, so a safe state reaches the mill (hold, then stop)
   const runtime::RunOutcome outcome = runtime::run_on_threads(assembled, runner, hooks, options);
   mill.stop_answering();
   mill.leave(result, assembled.machine().stop_confirmed(), hal::posix_clock::monotonic_now_ns());
@@ -160,6 +166,7 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   const bool realtime = runner != nullptr;
   const auto wall_start = std::chrono::steady_clock::now();
   SimResult result;
+  result.standoff_mm = job.rig.facts.machine_standoff_mm;
   MillWiring mill(job, realtime);
   if (!mill.error().empty()) {
     result.error = mill.error();

@@ -38,6 +38,7 @@ namespace stencil::board::sim {
 enum class HapticTransport : std::uint8_t { Direct, Pio, Can };
 
 struct SimJob {
+  SimRig rig;  // the configured rig and the simulated mill's truth (sim_facts.hpp)
   HapticTransport transport = HapticTransport::Direct;
   const tables::PartTables* part = nullptr;
   stencil::sim::StockBox stock{};
@@ -89,6 +90,7 @@ struct SimResult {
   double unmachined_volume_mm3 = 0.0;
   double reachable_volume_mm3 = 0.0;
   double allowance_volume_mm3 = 0.0;   // left on the part by the controller's standoff (not unmachined)
+  double standoff_mm = 0.0;            // that standoff
   double coverage_fraction = 0.0;  // reachable triangles touched
   double max_force_n = 0.0;
   double max_offset_mm = 0.0;
@@ -159,10 +161,12 @@ struct SimResult {
 
 // The cycle's configuration in the simulation (frames, reach, the mill's speed; overruns count in
 // real time only).
-[[nodiscard]] control::ControllerConfig controller_config(bool realtime);
+[[nodiscard]] control::ControllerConfig controller_config(bool realtime, const SimRig& rig = {});
 
-// The simulation board's device -> world -> machine frames (above).
-[[nodiscard]] motion::MachineFrames frames();
+// The simulation board's device -> world -> machine frames (above), as the controller believes them.
+[[nodiscard]] motion::MachineFrames frames(const SimRig& rig = {});
+// The same with the simulated mill's true steps per mm: where the mill's steps really put the tool.
+[[nodiscard]] motion::MachineFrames true_frames(const SimRig& rig);
 
 // The default stock for a part: its bounding box grown by 2 mm on each side in x and y (within the
 // workspace), from the floor to 1 mm above the part's top.

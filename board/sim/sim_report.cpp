@@ -65,7 +65,7 @@ nlohmann::json simulation_sections(const SimResult& r) {
        {{"volume_mm3", r.unmachined_volume_mm3},
         {"fraction", r.reachable_volume_mm3 > 0.0 ? r.unmachined_volume_mm3 / r.reachable_volume_mm3 : 0.0},
         {"reachable_volume_mm3", r.reachable_volume_mm3},
-        {"standoff_mm", kStandoffMm},
+        {"standoff_mm", r.standoff_mm},
         {"standoff_volume_mm3", r.allowance_volume_mm3}}},
       {"coverage_fraction", r.coverage_fraction},
       {"complete", r.complete},
@@ -120,7 +120,7 @@ std::string summary(const SimResult& r) {
                 static_cast<unsigned long long>(r.machine_updates),
                 r.gouge_measured ? std::to_string(r.gouge_max_depth_mm).c_str() : "not measured (not a ball end mill)",
                 r.gouge_volume_mm3, r.removed_volume_mm3, r.unmachined_volume_mm3, 100.0 * fraction,
-                kStandoffMm, r.allowance_volume_mm3,
+                r.standoff_mm, r.allowance_volume_mm3,
                 100.0 * r.coverage_fraction, r.max_force_n, r.max_offset_mm, r.machine_max_lag_mm, r.compute_us.p50,
                 r.compute_us.p999, r.compute_us.max,
                 r.safe_state == control::SafeReason::None ? "none" : control::safe_reason_name(r.safe_state));

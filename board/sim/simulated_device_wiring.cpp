@@ -11,9 +11,9 @@
 
 namespace stencil::board::sim {
 
-SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand,
-                                             std::string& error)
-    : transport_(transport), direct_(kDeviceRange) {
+SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const hal::HapticRange& range,
+                                             const stencil::sim::OperatorHand& hand, std::string& error)
+    : transport_(transport), direct_(range) {
   const auto pose = [&hand, this](std::uint32_t, hal::MonotonicNs) {
     const Eigen::Vector3d at = disturbed(hand.handle_mm);
     return stencil::sim::SimulatedPose{{at.x(), at.y(), at.z()}, {0.0, 0.0}};
@@ -24,7 +24,7 @@ SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const st
       return;
     }
     device_link_ = std::make_unique<stencil::sim::PioDeviceLink>(window_->window());
-    pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), kDeviceRange);
+    pio_host_ = std::make_unique<hal::pio_shared_memory::PioHapticDevice>(&window_->window(), range);
     host_ = pio_host_.get();
   } else if (transport == HapticTransport::Can) {
     int fds[2] = {-1, -1};
@@ -37,7 +37,7 @@ SimulatedDeviceWiring::SimulatedDeviceWiring(HapticTransport transport, const st
     auto can_link = std::make_unique<stencil::sim::CanDeviceLink>(*device_channel_);
     can_device_link_ = can_link.get();
     device_link_ = std::move(can_link);
-    can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), kDeviceRange);
+    can_host_ = std::make_unique<hal::socketcan::SocketCanHapticDevice>(host_channel_.get(), range);
     host_ = can_host_.get();
   }
   if (device_link_ != nullptr) {

@@ -29,7 +29,8 @@ class SimulatedDeviceWiring {
  public:
   // `hand` must outlive the wiring: the device samples its handle. Not ready() when the transport
   // could not be set up (`error` says why).
-  SimulatedDeviceWiring(HapticTransport transport, const stencil::sim::OperatorHand& hand, std::string& error);
+  SimulatedDeviceWiring(HapticTransport transport, const hal::HapticRange& range, const stencil::sim::OperatorHand& hand,
+                        std::string& error);
   SimulatedDeviceWiring(const SimulatedDeviceWiring&) = delete;
   SimulatedDeviceWiring& operator=(const SimulatedDeviceWiring&) = delete;
   ~SimulatedDeviceWiring();

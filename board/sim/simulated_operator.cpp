@@ -23,7 +23,7 @@ SimulatedOperator::SimulatedOperator(const SimJob& job, bool lockstep)
       duration_s_(job.duration_s > 0.0 ? job.duration_s : job.script.duration_s()),
       lockstep_(lockstep),
       hand_(hand_at_start(job.script)),
-      wiring_(job.transport, hand_, wiring_error_) {}
+      wiring_(job.transport, rig::programs_device_range(job.rig.facts), hand_, wiring_error_) {}
 
 std::string SimulatedOperator::start() {
   if (!wiring_.ready()) {

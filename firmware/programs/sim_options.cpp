@@ -1,5 +1,7 @@
 #include "firmware/programs/sim_options.hpp"
 
+#include "board/sherline_suzuki/rig_config.hpp"
+
 #include "sim/operator/operator_script.hpp"
 
 namespace stencil::app {
@@ -100,6 +102,13 @@ bool check_inject(SimOptions& o, std::string& error) {
 }  // namespace
 
 void add_sim_options(CLI::App& app, SimOptions& options) {
+  app.add_option("--config", options.config_path,
+                 "a rig's configuration file (TOML, as stencil-rig --config; every key: board/sherline_suzuki/rig.toml): "
+                 "the simulation runs a copy of that rig, its mill as the file says unless --mill-truth "
+                 "(default: the compiled-in Sherline/Suzuki rig)");
+  app.add_option("--mill-truth", options.mill_truth_path,
+                 "a second configuration file: the simulated mill as it really is (its axis signs, steps per mm, "
+                 "backlash, travel, wiring), where it differs from what --config tells the controller");
   add_operator_options(app, options);
   add_record_options(app, options);
   add_display_options(app, options.display);
@@ -137,6 +146,29 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     error = o.fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)";
   }
   return error.empty();
+}
+
+bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
+  board::sherline_suzuki::RigConfig config;
+  if (!o.config_path.empty()) {
+    if (!board::sherline_suzuki::read_rig_config(o.config_path, config, error)) {
+      return false;
+    }
+    o.rig.facts = config.facts;
+    o.rig.home_world_mm = config.work_offset_mm;
+    o.rig.mill_truth = config.facts;
+    if (app.count("--priority") == 0) o.priority = config.cycle_priority;
+    if (app.count("--cpu") == 0) o.cpu = config.cycle_cpu;
+  }
+  if (!o.mill_truth_path.empty()) {
+    board::sherline_suzuki::RigConfig truth;
+    if (!board::sherline_suzuki::read_rig_config(o.mill_truth_path, truth, error)) {
+      error = "--mill-truth: " + error;
+      return false;
+    }
+    o.rig.mill_truth = truth.facts;
+  }
+  return true;
 }
 
 }  // namespace stencil::app

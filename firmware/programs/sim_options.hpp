@@ -8,11 +8,15 @@
 #include <CLI/CLI.hpp>
 
 #include "board/sim/fault_injection.hpp"
+#include "board/sim/sim_facts.hpp"
 #include "firmware/programs/display_option.hpp"
 
 namespace stencil::app {
 
 struct SimOptions {
+  std::string config_path;      // --config: the rig's configuration file (empty: the compiled-in rig)
+  std::string mill_truth_path;  // --mill-truth: the simulated mill as it really is (empty: as configured)
+  board::sim::SimRig rig;       // both, read by apply_sim_config
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
   std::string pattern_name = "raster";
@@ -48,5 +52,9 @@ void add_sim_options(CLI::App& app, SimOptions& options);
 // After parsing: how the options combine (and --inject read into `fault`; --replay implies --fast
 // unless paced, and no journal). False with the message for the terminal.
 [[nodiscard]] bool check_sim_options(const CLI::App& app, SimOptions& options, std::string& error);
+
+// After check_sim_options: --config and --mill-truth read and checked (file, line, key) into `rig`,
+// the file's threads under --priority and --cpu unless given. False with the message.
+[[nodiscard]] bool apply_sim_config(const CLI::App& app, SimOptions& options, std::string& error);
 
 }  // namespace stencil::app

@@ -25,6 +25,7 @@
 #include "board/sim/sim_report.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/output_probe.hpp"
+#include "board/sherline_suzuki/table_fit.hpp"
 #include "firmware/programs/sim_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
@@ -139,7 +140,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
            const std::string& stock_csv_path, double pace) {
   journal::JobHistory history;
   std::string error;
-  if (!journal::read_job_history(path, part.header.crc32, part.header.triangle_count, board::sim::frames(), {}, history,
+  if (!journal::read_job_history(path, part.header.crc32, part.header.triangle_count, board::sim::frames(job.rig), {}, history,
                                  error)) {
     return bad_input("--replay: " + error);
   }
@@ -213,8 +214,18 @@ bool load_part(const std::string& tables_path, std::vector<unsigned char>& file_
   return app::load_table_file(tables_path, file_bytes, part, error);
 }
 
-Eigen::Vector3d sim_home() {
-  return {board::sim::kHomeWorldMm[0], board::sim::kHomeWorldMm[1], board::sim::kHomeWorldMm[2]};
+Eigen::Vector3d sim_home(const board::sim::SimRig& rig) {
+  return {rig.home_world_mm[0], rig.home_world_mm[1], rig.home_world_mm[2]};
+}
+
+// The scripted hand moves a little slower than the virtual tool may (0.8 of it), so that the virtual
+// tool keeps up with it and a scripted job is not a tug against the speed limit.
+double operator_speed_mm_per_s(const board::sim::SimRig& rig) { return 0.8 * rig.facts.virtual_tool_speed_mm_per_s; }
+
+// The tables against the configured rig (its travel from the work offset, the device's reach).
+bool fits_the_rig(const app::SimOptions& o, const tables::PartTables& part, std::string& error) {
+  const std::string name = o.tables_path.empty() ? std::string("the baked-in hex prism") : o.tables_path;
+  return board::sherline_suzuki::check_tables_fit(part.header, name, o.rig.facts, {o.rig.home_world_mm, 0.0, 0.0}, error);
 }
 
 // The job the options describe: its stock, the operator's script and, in `job_text`, what makes it
@@ -222,6 +233,7 @@ Eigen::Vector3d sim_home() {
 bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::sim::SimJob& job, std::string& job_text,
               std::string& error) {
   job.part = &part;
+  job.rig = o.rig;
   job.stock = board::sim::default_stock(part);
   if (!o.stock_text.empty() && !parse_stock(o.stock_text, part, job.stock, error)) {
     return false;
@@ -235,8 +247,9 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
                                  : o.pattern_name == "plunge"   ? sim::Pattern::Plunge
                                  : o.pattern_name == "thinwall" ? sim::Pattern::Thinwall
                                                                 : sim::Pattern::Random;
-    job.script = sim::make_pattern(pattern, job.stock, sim_home(), board::sim::kOperatorSpeedMmPerS,
-                                   board::sim::kDeviceMmPerWorldMm, o.seed, board::sim::touch_tip_of(part, job.stock), o.moves);
+    job.script = sim::make_pattern(pattern, job.stock, sim_home(job.rig), operator_speed_mm_per_s(job.rig),
+                                   job.rig.facts.haptic_to_machine_scale, o.seed, board::sim::touch_tip_of(part, job.stock),
+                                   o.moves);
   }
   char numbers[200];
   std::snprintf(numbers, sizeof numbers, " seed=%llu moves=%d stock=%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
@@ -244,7 +257,9 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
                 job.stock.low_mm.z(), job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
   job_text = "tables=" + (o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path) +
              " operator=" + (o.operator_path.empty() ? std::string("-") : o.operator_path) +
-             " pattern=" + (o.operator_path.empty() ? o.pattern_name : std::string("-")) + numbers;
+             " pattern=" + (o.operator_path.empty() ? o.pattern_name : std::string("-")) + numbers +
+             (o.config_path.empty() ? std::string() : " config=" + o.config_path) +
+             (o.mill_truth_path.empty() ? std::string() : " mill-truth=" + o.mill_truth_path);
   if (job_text.size() > 1024) {
     error = "--tables and --operator: paths too long to record in the journal (" + std::to_string(job_text.size()) +
             " bytes of the job; at most 1024)";
@@ -258,7 +273,7 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
 bool prepare_resume(app::SimOptions& o, const tables::PartTables& part, const std::string& job_text,
                     board::sim::SimJob& job, journal::JobJournalRequest& request, std::string& error) {
   journal::JobHistory history;
-  if (!journal::read_job_history(o.resume_path, part.header.crc32, part.header.triangle_count, board::sim::frames(), {},
+  if (!journal::read_job_history(o.resume_path, part.header.crc32, part.header.triangle_count, board::sim::frames(job.rig), {},
                                  history, error)) {
     error = "--resume: " + error;
     return false;
@@ -274,8 +289,8 @@ bool prepare_resume(app::SimOptions& o, const tables::PartTables& part, const st
   // Where the cut stopped: the mill's last target (the stock is cut there), else the virtual tool.
   const Eigen::Vector3d rejoin = history.machine_commands > 0 ? history.last_commanded_tip_mm : history.last_virtual_tip_mm;
   double approach_s = 0.0;
-  job.script = sim::carry_on(job.script, history.script_s, sim_home(), rejoin, board::sim::kOperatorSpeedMmPerS,
-                             board::sim::kDeviceMmPerWorldMm, approach_s);
+  job.script = sim::carry_on(job.script, history.script_s, sim_home(job.rig), rejoin, operator_speed_mm_per_s(job.rig),
+                             job.rig.facts.haptic_to_machine_scale, approach_s);
   request.resume.segment = history.segments;
   request.resume.script_s = history.script_s;
   request.resume.approach_s = approach_s;
@@ -435,7 +450,8 @@ int main(int argc, char** argv) {
   tables::PartTables part{};
   board::sim::SimJob job;
   std::string job_text;
-  if (!app::check_sim_options(app, o, error) || !load_part(o.tables_path, file_bytes, part, error) ||
+  if (!app::check_sim_options(app, o, error) || !app::apply_sim_config(app, o, error) ||
+      !load_part(o.tables_path, file_bytes, part, error) || !fits_the_rig(o, part, error) ||
       !make_job(o, part, job, job_text, error)) {
     return bad_input(error);
   }
@@ -483,7 +499,7 @@ int main(int argc, char** argv) {
   }
   // The display, before the job: a page opened now sees the job from its start.
   app::Display display;
-  if (!display.start(o.display, part, board::sim::controller_config(o.real_time()), "stencil-sim", error)) {
+  if (!display.start(o.display, part, board::sim::controller_config(o.real_time(), job.rig), "stencil-sim", error)) {
     return bad_input(error);
   }
   job.display = display.feed();

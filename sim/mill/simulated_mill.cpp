@@ -31,7 +31,7 @@ StepOutcome SimulatedMill::step_motor(Axis axis, StepDirection direction) {
   }
   const MillAxisConfig& limits = config_.axes[index_of(axis)];
   AxisState& state = axes_[index_of(axis)];
-  const std::int64_t motor = state.motor_steps + static_cast<std::int64_t>(direction);
+  const std::int64_t motor = state.motor_steps + static_cast<std::int64_t>(direction) * limits.motor_direction;
   // The nut sits in [motor - backlash, motor]; it moves only when the screw pushes it.
   std::int64_t nut = state.axis_steps;
   if (nut < motor - limits.backlash_steps) nut = motor - limits.backlash_steps;

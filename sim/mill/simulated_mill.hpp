@@ -21,6 +21,9 @@ struct MillAxisConfig {
   std::int64_t travel_max_steps;     // high hard stop
   std::int64_t home_switch_edge_steps;  // the switch is closed while the axis is below this, open at/above it
   std::int64_t initial_position_steps;  // where the axis stands at power-up
+  // 1: a positive motor step moves the axis to larger machine coordinates; -1: the motor is wired
+  // backwards (a configuration's wrong axis sign), so every step goes the other way.
+  int motor_direction = 1;
 };
 
 struct MillConfig {
