@@ -176,6 +176,11 @@ const Key kKeys[] = {
    [](RigConfig& c, const Value& v) { c.work_offset_mm = v.n; }},
   {"job.output_folder", Kind::Text, 0, 0, false, "folder for journals; empty or absent: the current folder",
    [](RigConfig& c, const Value& v) { c.output_folder = v.text; }},
+  // [commissioning]
+  {"commissioning.jog_mm", Kind::Real, 0.5, 20, true, "mm each axis moves into its travel, then back half of it",
+   [](RigConfig& c, const Value& v) { c.commissioning.jog_mm = v.n[0]; }},
+  {"commissioning.tolerance_mm", Kind::Real, 0.001, 1, true, "mm a reading may differ from the commanded move",
+   [](RigConfig& c, const Value& v) { c.commissioning.tolerance_mm = v.n[0]; }},
 };
 // clang-format on
 
@@ -372,6 +377,13 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
   if (c.machine_priority >= c.cycle_priority) {
     return where("threads.machine_priority") + "threads.machine_priority " + std::to_string(c.machine_priority) +
            ": expected below threads.cycle_priority " + std::to_string(c.cycle_priority);
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    if (c.commissioning.jog_mm >= f.workspace_mm[axis]) {
+      return where("commissioning.jog_mm") + "commissioning.jog_mm " + number_text(c.commissioning.jog_mm) +
+             ": expected under every axis's travel (" + static_cast<char>('x' + axis) + ": " +
+             number_text(f.workspace_mm[axis]) + " mm)";
+    }
   }
   if (f.mmc4s.heartbeat_output == f.mmc4s.spindle_output) {
     return where("machine.board.heartbeat_output") + "machine.board.heartbeat_output: expected another output than "

@@ -9,6 +9,7 @@
 #include <string>
 #include <string_view>
 
+#include "board/sherline_suzuki/commissioning.hpp"
 #include "board/sherline_suzuki/rig_facts.hpp"
 
 namespace stencil::board::sherline_suzuki {
@@ -22,6 +23,7 @@ struct RigConfig {
   int machine_priority = 70;        // SCHED_FIFO, below the cycle (it always preempts the machine thread)
   std::array<double, 3> work_offset_mm = kHomeWorldMm;  // the tool tip in the part's frame with the machine at home
   std::string output_folder;        // where journals go by default ("": the current folder)
+  CommissioningSettings commissioning;
 };
 
 // Reads `text` (named `source` in messages) over the defaults in `config`. False with `error` naming

@@ -65,4 +65,14 @@ bool open_rig_devices(const RigFacts& facts, const std::string& serial_path, con
   return true;
 }
 
+bool open_rig_machine(const RigFacts& facts, const std::string& serial_path, RigDevices& devices, std::string& error) {
+  char port_error[256] = {};
+  if (!devices.port.open(serial_path.c_str(), facts.serial_baud, port_error)) {
+    error = std::string("the mill's CY545: ") + port_error;
+    return false;
+  }
+  devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, cy545_config(facts));
+  return true;
+}
+
 }  // namespace stencil::board::sherline_suzuki

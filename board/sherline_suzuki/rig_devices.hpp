@@ -41,4 +41,8 @@ struct RigDevices {
                                     RigDevices& devices,
                                     const std::function<void(const std::string&)>& note, std::string& error);
 
+// The serial port and the CY545 link only (commissioning needs no haptic device).
+[[nodiscard]] bool open_rig_machine(const RigFacts& facts, const std::string& serial_path, RigDevices& devices,
+                                    std::string& error);
+
 }  // namespace stencil::board::sherline_suzuki

@@ -40,6 +40,9 @@ class MillWiring final : public runtime::JobHooks {
   [[nodiscard]] stencil::sim::cy545::FakeCy545& fake() { return fake_; }
   [[nodiscard]] stencil::sim::MachinedPart& machined() { return machined_; }
   [[nodiscard]] const stencil::sim::MachinedPart& machined() const { return machined_; }
+  // The simulated mill itself (virtual time: no thread of the fake's is running), for what a person
+  // at it would see.
+  [[nodiscard]] const stencil::sim::SimulatedMill& mill() const { return mill_; }
 
   // Real time: the fake answers from its own thread until stop_answering().
   void start_answering();

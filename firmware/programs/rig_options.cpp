@@ -37,7 +37,11 @@ void add_job_options(CLI::App& app, RigOptions& o) {
                  "board/sherline_suzuki/rig.toml): checked before anything is opened. Without it, the compiled-in "
                  "Sherline/Suzuki rig; the options below override the file");
   app.add_flag("--config-keys", o.config_keys, "print every key of the configuration file with its type, unit and range, and exit");
-  app.add_option("--tables", o.tables_path, "the part's .stbl (required)");
+  app.add_flag("--commission", o.commission,
+               "commission a new or changed configuration instead of running a job (spindle off, no haptic device): "
+               "homes, then moves each axis into its travel and back while you type a dial indicator's readings; "
+               "says what disagrees with the file (axis sign, steps per mm) and proposes the backlash line");
+  app.add_option("--tables", o.tables_path, "the part's .stbl (required for a job)");
   app.add_option("--serial", o.serial_path, "the CY545's serial port, e.g. /dev/ttyS0 (default: the file's machine.serial_port)");
   app.add_option("--haptic", o.haptic, "the haptic link: pio:/dev/uioN or can:IFACE (default: the file's haptic.link)");
   app.add_flag("--require-rt", o.require_rt, "refuse to run without PREEMPT_RT and SCHED_FIFO");
@@ -160,11 +164,11 @@ bool apply_rig_config(const CLI::App& app, RigOptions& o, std::string& error) {
   }
   // Always below the cycle; without a file, 10 below it as before there was one.
   o.machine_priority = file ? std::min(c.machine_priority, o.priority - 1) : std::max(1, o.priority - 10);
-  if (o.tables_path.empty()) {
+  if (o.tables_path.empty() && !o.commission) {
     error = "--tables: the part's .stbl is required";
   } else if (o.serial_path.empty()) {
     error = "--serial: the CY545's serial port is required (or machine.serial_port in the --config file)";
-  } else if (o.haptic.empty()) {
+  } else if (o.haptic.empty() && !o.commission) {
     error = "--haptic: the haptic link is required (or haptic.link in the --config file)";
   }
   return error.empty();

@@ -16,6 +16,7 @@ namespace stencil::app {
 struct RigOptions {
   std::string config_path;    // --config: the rig's file (empty: the compiled-in Sherline/Suzuki rig)
   bool config_keys = false;   // --config-keys: print every key of the file and exit
+  bool commission = false;    // --commission: commission the mill against a dial indicator instead of a job
   board::sherline_suzuki::RigConfig config;  // the file's (or the defaults), with the command line's overrides
   std::string tables_path;
   std::string serial_path;

@@ -109,6 +109,10 @@ void add_sim_options(CLI::App& app, SimOptions& options) {
   app.add_option("--mill-truth", options.mill_truth_path,
                  "a second configuration file: the simulated mill as it really is (its axis signs, steps per mm, "
                  "backlash, travel, wiring), where it differs from what --config tells the controller");
+  app.add_flag("--commission", options.commission,
+               "commission the simulated rig instead of running a job: it homes, then moves each axis into its "
+               "travel and back while a simulated machinist reads a dial indicator from the mill's truth; findings "
+               "(a wrong axis sign, steps per mm, backlash) on stdout, exit status 3 when there are any");
   add_operator_options(app, options);
   add_record_options(app, options);
   add_display_options(app, options.display);
@@ -122,6 +126,15 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
       (app.count("--priority") + app.count("--cpu") + app.count("--require-rt")) > 0) {
     error = "--priority, --cpu and --require-rt are for the real-time threads of --speed 1 only";
     return false;
+  }
+  if (o.commission) {
+    if (!o.replay_path.empty() || !o.resume_path.empty() || !o.inject_text.empty() || o.speed > 0.0 ||
+        o.display.requested()) {
+      error = "--commission runs on the virtual clock by itself: no --replay, --resume, --inject, --speed or display with it";
+      return false;
+    }
+    o.fast = true;
+    o.no_journal = true;
   }
   if (!o.inject_text.empty() && !check_inject(o, error)) {
     return false;
@@ -157,6 +170,7 @@ bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
     o.rig.facts = config.facts;
     o.rig.home_world_mm = config.work_offset_mm;
     o.rig.mill_truth = config.facts;
+    o.commissioning = config.commissioning;
     if (app.count("--priority") == 0) o.priority = config.cycle_priority;
     if (app.count("--cpu") == 0) o.cpu = config.cycle_cpu;
   }

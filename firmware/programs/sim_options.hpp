@@ -7,6 +7,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "board/sherline_suzuki/commissioning.hpp"
 #include "board/sim/fault_injection.hpp"
 #include "board/sim/sim_facts.hpp"
 #include "firmware/programs/display_option.hpp"
@@ -17,6 +18,8 @@ struct SimOptions {
   std::string config_path;      // --config: the rig's configuration file (empty: the compiled-in rig)
   std::string mill_truth_path;  // --mill-truth: the simulated mill as it really is (empty: as configured)
   board::sim::SimRig rig;       // both, read by apply_sim_config
+  bool commission = false;      // --commission: commissioning on the simulated rig instead of a job
+  board::sherline_suzuki::CommissioningSettings commissioning;  // the file's [commissioning]
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
   std::string pattern_name = "raster";

@@ -21,6 +21,7 @@
 #include "firmware/programs/rig_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/programs/terminal_commands.hpp"
+#include "firmware/programs/terminal_machinist.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
 #include "firmware/runtime/rt_readiness.hpp"
 #include "firmware/services/journal/job_history.hpp"
@@ -169,6 +170,33 @@ int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::
   return asked ? 0 : kExitNotStarted;
 }
 
+// --commission: the mill alone (no haptic device), the machinist at the terminal. 0 when the file
+// agrees with the mill, 3 when something does not (or it could not run).
+int commission(const app::RigOptions& o) {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  for (const int signal_number : {SIGINT, SIGTERM, SIGHUP, SIGQUIT}) {
+    sigaction(signal_number, &action, nullptr);
+  }
+  board::sherline_suzuki::RigDevices devices;
+  std::string error;
+  if (!board::sherline_suzuki::open_rig_machine(o.config.facts, o.serial_path, devices, error)) {
+    return fail(kExitNotStarted, error);
+  }
+  app::TerminalMachinist machinist(&interrupted);
+  const board::sherline_suzuki::CommissioningResult result = board::sherline_suzuki::commission(
+      o.config.facts, o.config.commissioning, *devices.link, devices.clock, machinist, &interrupted);
+  for (const std::string& finding : result.findings) {
+    std::printf("stencil-rig: commissioning: %s\n", finding.c_str());
+  }
+  if (!result.backlash_line.empty()) {
+    std::printf("stencil-rig: commissioning: measured %s\n", result.backlash_line.c_str());
+  }
+  std::printf("stencil-rig: commissioning %s\n", result.passed ? "passed: the configuration agrees with the mill"
+                                                              : "FAILED: correct the configuration before any cut");
+  return result.passed ? 0 : kExitNotStarted;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -196,8 +224,13 @@ int main(int argc, char** argv) {
   std::string error;
   std::vector<unsigned char> bytes;
   tables::PartTables part{};
-  if (!app::apply_rig_config(app, o, error) || !app::check_rig_options(o, job.offset, job.stock, error) ||
-      !app::load_table_file(o.tables_path, bytes, part, error)) {
+  if (!app::apply_rig_config(app, o, error)) {
+    return fail(kExitBadInput, error);
+  }
+  if (o.commission) {
+    return commission(o);
+  }
+  if (!app::check_rig_options(o, job.offset, job.stock, error) || !app::load_table_file(o.tables_path, bytes, part, error)) {
     return fail(kExitBadInput, error);
   }
   job.facts = o.config.facts;

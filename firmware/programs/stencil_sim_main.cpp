@@ -26,6 +26,7 @@
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/output_probe.hpp"
 #include "board/sherline_suzuki/table_fit.hpp"
+#include "board/sim/simulated_commissioning.hpp"
 #include "firmware/programs/sim_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
@@ -221,6 +222,21 @@ Eigen::Vector3d sim_home(const board::sim::SimRig& rig) {
 // The scripted hand moves a little slower than the virtual tool may (0.8 of it), so that the virtual
 // tool keeps up with it and a scripted job is not a tug against the speed limit.
 double operator_speed_mm_per_s(const board::sim::SimRig& rig) { return 0.8 * rig.facts.virtual_tool_speed_mm_per_s; }
+
+// --commission: the simulated rig commissioned; what it found, and 0 when nothing, else 3.
+int commission(const app::SimOptions& o, const board::sim::SimJob& job) {
+  const board::sherline_suzuki::CommissioningResult result = board::sim::commission_simulated_rig(
+      job, o.commissioning, &interrupted, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
+  for (const std::string& finding : result.findings) {
+    std::printf("commissioning: %s\n", finding.c_str());
+  }
+  if (!result.backlash_line.empty()) {
+    std::printf("commissioning: measured %s\n", result.backlash_line.c_str());
+  }
+  std::printf("commissioning: %s\n", result.passed ? "passed: the configuration agrees with the mill"
+                                                    : "FAILED: correct the configuration before any cut");
+  return result.passed ? 0 : kExitSafeState;
+}
 
 // The tables against the configured rig (its travel from the work offset, the device's reach).
 bool fits_the_rig(const app::SimOptions& o, const tables::PartTables& part, std::string& error) {
@@ -454,6 +470,9 @@ int main(int argc, char** argv) {
       !load_part(o.tables_path, file_bytes, part, error) || !fits_the_rig(o, part, error) ||
       !make_job(o, part, job, job_text, error)) {
     return bad_input(error);
+  }
+  if (o.commission) {
+    return commission(o, job);
   }
   if (!o.replay_path.empty()) {
     return replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed);

@@ -495,8 +495,9 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     }
     if (travelled >= config_.motion.homing_travel_steps) {
       std::snprintf(last_error_, sizeof last_error_,
-                    "homing axis %c: no home switch within %d steps of travel: check the switch, its wiring and the "
-                    "closed level in the configuration",
+                    "homing axis %c: no home switch within %d steps of travel moving -: check the axis sign "
+                    "(machine.axis_sign: a motor that runs the other way never reaches it), the switch, its wiring "
+                    "and its closed level in the configuration",
                     name, travelled);
       latch_fault(MachineFault::PositionMismatch);
       return false;

@@ -749,6 +749,51 @@ case_rig_refuses_a_bad_configuration() {
   expect_stderr "not_a_tty: not a serial port" "the command line's port over the file's"
 }
 
+# The shipped example configuration is the compiled-in rig: the same job gives the same report with
+# it as without it (wall-clock fields aside). make demo's whole job is compared by hand (README).
+case_example_configuration_gives_the_same_report() {
+  strip_wall_clock() {
+    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
+  }
+  install -m 600 "$repo/board/sherline_suzuki/rig.toml" rig.toml
+  run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report defaults.json
+  expect_status 0
+  run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report configured.json --config rig.toml
+  expect_status 0
+  if ! diff <(strip_wall_clock defaults.json) <(strip_wall_clock configured.json); then
+    fail "the example configuration gave another report than the compiled-in rig"
+  fi
+}
+
+# A configuration wrong against the simulated mill: an X sign the mill does not have is stopped by
+# homing (the job never starts, nothing is cut) and by commissioning; steps per mm 1 % off are found by
+# commissioning's measured move, which says what the file should say.
+case_commissioning_finds_a_wrong_sign_and_wrong_steps() {
+  install -m 600 "$repo/board/sherline_suzuki/rig.toml" rig.toml
+  sed 's/^axis_sign = \[-1, -1, -1\]/axis_sign = [1, -1, -1]/' rig.toml >sign.toml
+  sed -e 's/^steps_per_mm = \[640.0, 640.0, 640.0\]/steps_per_mm = [646.4, 646.4, 646.4]/' \
+    -e 's/^backlash_mm = .*/backlash_mm = [0.12376237623762376, 0.0495049504950495, 0.12376237623762376]/' rig.toml >steps.toml
+  chmod 600 sign.toml steps.toml
+  grep -q "^axis_sign = \[1, -1, -1\]" sign.toml && grep -q "^steps_per_mm = \[646.4" steps.toml ||
+    fail "the mill's truth could not be written"
+  run_sim --commission --config rig.toml
+  expect_status 0
+  grep -q "commissioning: passed" stdout.txt || fail "the example configuration did not pass on its own mill"
+  run_sim --commission --config rig.toml --mill-truth sign.toml
+  expect_status 3
+  grep -q "homing axis X: no home switch within [0-9]* steps of travel moving -: check the axis sign" stdout.txt ||
+    fail "commissioning did not name the axis sign"
+  grep -q "axis X moved" stdout.txt && fail "an axis was jogged after homing failed"
+  run_sim --fast --pattern raster --config rig.toml --mill-truth sign.toml --no-journal --report job.json
+  expect_status 3
+  expect_stderr "the machine did not start: homing axis X: .*check the axis sign" "that homing stopped the job"
+  [ ! -e job.json ] || fail "a job that never started wrote a report"
+  run_sim --commission --config rig.toml --mill-truth steps.toml
+  expect_status 3
+  grep -q "axis X: moved 4.950 mm for 5.000 mm commanded (-1.00 %): machine.steps_per_mm would be 646.46; the file says 640" stdout.txt ||
+    fail "commissioning did not find the steps per mm 1 % off"
+}
+
 # The rig program on a machine without the rig: it checks what it can and says what is missing.
 case_rig_without_the_hardware_fails_cleanly() {
   mkdir -p parts && "$(dirname "$sim")/stencil-sample-parts" parts >/dev/null || fail "stencil-sample-parts failed"
