@@ -134,7 +134,12 @@ CommissioningResult commission(const RigFacts& facts, const CommissioningSetting
   if (whole) {
     result.backlash_line = format("backlash_mm = [%.10g, %.10g, %.10g]", result.backlash_mm[0], result.backlash_mm[1],
                                   result.backlash_mm[2]);
-    if (result.backlash_mm != facts.backlash_mm) {
+    // A difference the indicator can tell: one step (1.6 um here) is finer than a dial reads.
+    bool differs = false;
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      differs = differs || std::fabs(result.backlash_mm[axis] - facts.backlash_mm[axis]) > settings.tolerance_mm;
+    }
+    if (differs) {
       result.findings.push_back("measured backlash: put `" + result.backlash_line + "` in [machine] (the file says " +
                                 format("[%g, %g, %g])", facts.backlash_mm[0], facts.backlash_mm[1], facts.backlash_mm[2]));
     }

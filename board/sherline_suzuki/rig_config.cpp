@@ -1,13 +1,15 @@
 #include "board/sherline_suzuki/rig_config.hpp"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
+#include <zlib.h>
+
+#include <cerrno>
 
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 // toml++ header-only, without exceptions: a parse error is a value (its description and line).
 #define TOML_EXCEPTIONS 0
@@ -41,6 +43,10 @@ std::array<std::uint8_t, 3> bytes3(const Value& v) {
 }
 constexpr double kNs = 1e6;  // nanoseconds per millisecond
 
+const char* port_baud(const Value& v) {
+  const double baud = v.n[0];
+  return baud == 9600 || baud == 19200 || baud == 38400 || baud == 57600 ? nullptr : "9600, 19200, 38400 or 57600";
+}
 const char* one_resolution(const Value& v) {
   return v.n[0] == v.n[1] && v.n[1] == v.n[2]
              ? nullptr
@@ -76,8 +82,8 @@ const Key kKeys[] = {
   // [machine]: the mill (Sherline 3-axis) and its CY545 on the MMC-4S board, over RS-232.
   {"machine.serial_port", Kind::Text, 0, 0, true, "the CY545's RS-232 port",
    [](RigConfig& c, const Value& v) { c.serial_port = v.text; }, device_path},
-  {"machine.serial_baud", Kind::Integer, 300, 57600, true, "baud, 8N1; the CY545 finds the rate itself",
-   [](RigConfig& c, const Value& v) { c.facts.serial_baud = static_cast<std::uint32_t>(v.n[0]); }},
+  {"machine.serial_baud", Kind::Integer, 9600, 57600, true, "baud, 8N1; the CY545 finds the rate itself",
+   [](RigConfig& c, const Value& v) { c.facts.serial_baud = static_cast<std::uint32_t>(v.n[0]); }, port_baud},
   {"machine.steps_per_mm", Kind::Reals3, 1, 100000, true, "motor steps per mm, x y z",
    [](RigConfig& c, const Value& v) { c.facts.steps_per_mm = v.n[0]; }, one_resolution},
   {"machine.axis_sign", Kind::Integers3, -1, 1, true,
@@ -90,7 +96,7 @@ const Key kKeys[] = {
    [](RigConfig& c, const Value& v) { c.facts.backlash_mm = v.n; }},
   {"machine.max_speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s per axis",
    [](RigConfig& c, const Value& v) { c.facts.max_speed_mm_per_s = v.n[0]; }},
-  {"machine.step_rate_steps_per_s", Kind::Real, 1, 27000, true, "steps/s, the CY545's rate (27000 at most)",
+  {"machine.step_rate_steps_per_s", Kind::Integer, 1, 27000, true, "steps/s, the CY545's rate, 27000 at most",
    [](RigConfig& c, const Value& v) { c.facts.step_rate_steps_per_s = v.n[0]; }},
   {"machine.update_hz", Kind::Real, 1, 200, true, "machine updates per second over the serial line",
    [](RigConfig& c, const Value& v) { c.facts.machine_update_hz = v.n[0]; }},
@@ -134,6 +140,10 @@ const Key kKeys[] = {
    [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_switch_closed_level = v.b; }},
   {"machine.board.channel_lines_latch_data", Kind::Flag, 0, 0, true, "true: each channel line latches its data bit",
    [](RigConfig& c, const Value& v) { c.facts.mmc4s.channel_lines_latch_data = v.b[0]; }},
+  {"machine.board.step_direction", Kind::Integers3, -1, 1, true,
+   "x y z: +1 when the CY545's + steps move the axis away from its home switch, -1 when the direction line is wired the other way",
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.step_direction = {static_cast<int>(v.n[0]), static_cast<int>(v.n[1]), static_cast<int>(v.n[2])}; },
+   unit_signs},
   // [haptic]: the device (Suzuki 5-DOF) and the cycle.
   {"haptic.link", Kind::Text, 0, 0, true, "the device's link",
    [](RigConfig& c, const Value& v) { c.haptic_link = v.text; }, haptic_link_name},
@@ -216,8 +226,8 @@ bool read_scalar(const toml::node& node, Kind kind, double& number, bool& flag, 
   switch (kind) {
     case Kind::Real:
     case Kind::Reals3:
-      if (!node.is_number()) return false;
-      number = node.value<double>().value_or(0.0);
+      if (!node.is_number() || !node.value<double>().has_value()) return false;  // (an integer past 2^53 has none)
+      number = *node.value<double>();
       return true;
     case Kind::Integer:
     case Kind::Integers3:
@@ -282,11 +292,25 @@ struct Reading {
 
 std::string at(const std::string& source, long line) { return source + ":" + std::to_string(line) + ": "; }
 
+// Where a missing key belongs: its section's header line, or the file's end when there is no such section.
+std::string where_missing(const toml::table& root, const std::string& name, const std::string& source) {
+  const std::string section = name.substr(0, name.rfind('.'));
+  const toml::node* node = root.at_path(section).node();
+  if (node != nullptr && node->is_table() && node->source().begin.line > 0) {
+    return at(source, static_cast<long>(node->source().begin.line)) + "[" + section + "]: ";
+  }
+  return source + ": no [" + section + "] section: ";
+}
+
 bool read_table(const toml::table& table, const std::string& prefix, Reading& reading) {
   for (auto&& [name_key, node] : table) {
     const std::string name = prefix + std::string(name_key.str());
     const long line = static_cast<long>(node.source().begin.line);
-    if (node.is_table() && is_section(name)) {
+    if (is_section(name)) {
+      if (!node.is_table()) {
+        reading.error = at(reading.source, line) + name + ": expected the table [" + name + "], not a value";
+        return false;
+      }
       if (!read_table(*node.as_table(), name + ".", reading)) return false;
       continue;
     }
@@ -385,9 +409,32 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
              number_text(f.workspace_mm[axis]) + " mm)";
     }
   }
+  return "";
+}
+
+std::string wiring_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  const RigFacts& f = c.facts;
+  const auto where = [&](const char* name) {
+    const auto found = lines.find(name);
+    return found == lines.end() ? source + ": " : at(source, found->second);
+  };
   if (f.mmc4s.heartbeat_output == f.mmc4s.spindle_output) {
     return where("machine.board.heartbeat_output") + "machine.board.heartbeat_output: expected another output than "
            "the spindle's";
+  }
+  // The heartbeat toggles every half period, at a machine update: the relay must not drop between two.
+  const double gap_ms = static_cast<double>(f.mmc4s.heartbeat_period_ns) / 2e6 + 1000.0 / f.machine_update_hz;
+  const double relay_ms = static_cast<double>(f.watchdog_relay_timeout_ns) / 1e6;
+  if (f.mmc4s.heartbeat_output >= 0 && 2.0 * gap_ms > relay_ms) {
+    return where("machine.watchdog_relay_timeout_ms") + "machine.watchdog_relay_timeout_ms " + number_text(relay_ms) +
+           ": expected at least twice the heartbeat's longest gap (half of machine.board.heartbeat_period_ms plus one "
+           "machine update: " + number_text(gap_ms) + " ms), or the relay cuts the power of a running mill";
+  }
+  // Every homing rate and leg is at least one step at the configured steps per mm.
+  if (mm_to_steps(f.homing_slow_speed_mm_per_s, f) < 1 || mm_to_steps(f.homing_chunk_mm, f) < 1) {
+    return where("machine.homing.slow_speed_mm_per_s") + "machine.homing.slow_speed_mm_per_s " +
+           number_text(f.homing_slow_speed_mm_per_s) + " and machine.homing.chunk_mm " + number_text(f.homing_chunk_mm) +
+           ": expected each at least one step at " + number_text(f.steps_per_mm) + " steps/mm";
   }
   return "";
 }
@@ -395,6 +442,20 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
 }  // namespace
 
 bool parse_rig_config(std::string_view text, const std::string& source, RigConfig& config, std::string& error) {
+  // ASCII only, comments included: toml++ 3.3.0 (Debian 12's) reaches __builtin_unreachable() on some
+  // non-ASCII code points (U+02B6 among them, in is_non_ascii_horizontal_whitespace), found by
+  // fuzz_rig_config; nothing in a rig's file needs more than ASCII.
+  long line = 1;
+  for (std::size_t offset = 0; offset < text.size(); ++offset) {
+    const auto byte = static_cast<unsigned char>(text[offset]);
+    if (byte >= 0x80) {
+      char found[96];
+      std::snprintf(found, sizeof found, "byte 0x%02X at offset %zu: expected ASCII text", byte, offset);
+      error = at(source, line) + found;
+      return false;
+    }
+    line += byte == '\n' ? 1 : 0;
+  }
   toml::parse_result parsed = toml::parse(text, source);
   if (!parsed) {
     error = at(source, static_cast<long>(parsed.error().source().begin.line)) + std::string(parsed.error().description());
@@ -408,13 +469,17 @@ bool parse_rig_config(std::string_view text, const std::string& source, RigConfi
   }
   for (const Key& key : kKeys) {
     if (key.required && reading.lines.count(key.name) == 0) {
-      error = source + ": missing the key '" + key.name + "': expected " + expected_of(key);
+      error = where_missing(parsed.table(), key.name, source) + "missing the key '" + key.name + "': expected " +
+              expected_of(key);
       return false;
     }
   }
   error = contradiction(read, reading.lines, source);
   if (error.empty()) {
     error = homing_contradiction(read, reading.lines, source);
+  }
+  if (error.empty()) {
+    error = wiring_contradiction(read, reading.lines, source);
   }
   if (!error.empty()) {
     return false;
@@ -423,32 +488,83 @@ bool parse_rig_config(std::string_view text, const std::string& source, RigConfi
   return true;
 }
 
-bool read_rig_config(const std::string& path, RigConfig& config, std::string& error) {
-  struct stat status {};
-  if (::stat(path.c_str(), &status) != 0 || !S_ISREG(status.st_mode)) {
-    error = path + ": no such configuration file";
+namespace {
+
+// Who may change the file (its owner: this program's user or root; nobody through its group or
+// everyone) and who may replace it (its folder: not writable by others unless sticky, as /tmp is).
+bool trusted(const std::string& path, const struct stat& file, std::string& error) {
+  if (!S_ISREG(file.st_mode)) {
+    error = path + ": not a regular file";
     return false;
   }
-  if (status.st_uid != 0 && status.st_uid != ::geteuid()) {
-    error = path + ": owned by user " + std::to_string(status.st_uid) + ": expected this program's user (" +
+  if (file.st_uid != 0 && file.st_uid != ::geteuid()) {
+    error = path + ": owned by user " + std::to_string(file.st_uid) + ": expected this program's user (" +
             std::to_string(::geteuid()) + ") or root, since the file decides where the tool goes";
     return false;
   }
-  if ((status.st_mode & (S_IWGRP | S_IWOTH)) != 0) {
+  if ((file.st_mode & (S_IWGRP | S_IWOTH)) != 0) {
     char mode[8];
-    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(status.st_mode & 07777));
+    std::snprintf(mode, sizeof mode, "%04o", static_cast<unsigned>(file.st_mode & 07777));
     error = path + ": writable by other users (mode " + mode + "): expected writable by its owner only (chmod go-w " +
             path + ")";
     return false;
   }
-  std::ifstream file(path, std::ios::binary);
-  std::stringstream text;
-  text << file.rdbuf();
-  if (!file) {
-    error = path + ": could not be read";
+  const std::size_t slash = path.rfind('/');
+  const std::string folder = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
+  struct stat parent {};
+  if (::stat(folder.c_str(), &parent) == 0 && (parent.st_mode & (S_IWGRP | S_IWOTH)) != 0 &&
+      (parent.st_mode & S_ISVTX) == 0) {
+    error = path + ": its folder " + folder + " is writable by other users, who could replace the file: expected "
+            "chmod go-w " + folder;
     return false;
   }
-  return parse_rig_config(text.str(), path, config, error);
+  return true;
+}
+
+}  // namespace
+
+bool read_rig_config(const std::string& path, RigConfig& config, std::string& error) {
+  // Opened once, not followed through a link, and checked through the descriptor it is read from.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NOFOLLOW | O_CLOEXEC);
+  if (fd < 0) {
+    error = path + (errno == ELOOP ? ": a symbolic link: expected the file itself" : ": no such configuration file");
+    return false;
+  }
+  struct stat status {};
+  std::string text;
+  bool ok = ::fstat(fd, &status) == 0 && trusted(path, status, error);
+  while (ok && text.size() < (1U << 20)) {
+    char chunk[4096];
+    const ssize_t got = ::read(fd, chunk, sizeof chunk);
+    if (got < 0) {
+      error = path + ": could not be read";
+      ok = false;
+    } else if (got == 0) {
+      break;
+    } else {
+      text.append(chunk, static_cast<std::size_t>(got));
+    }
+  }
+  ::close(fd);
+  if (ok && text.size() >= (1U << 20)) {
+    error = path + ": over 1 MiB: expected a rig's configuration";
+    ok = false;
+  }
+  RigConfig read = config;
+  if (!ok || !parse_rig_config(text, path, read, error)) {
+    return false;
+  }
+  // The journals' folder is looked at now, not when the first journal opens after the devices.
+  struct stat folder {};
+  if (!read.output_folder.empty() && (::stat(read.output_folder.c_str(), &folder) != 0 || !S_ISDIR(folder.st_mode) ||
+                                      ::access(read.output_folder.c_str(), W_OK | X_OK) != 0)) {
+    error = path + ": job.output_folder " + read.output_folder + ": expected a folder this program may write in";
+    return false;
+  }
+  config = read;
+  config.file_crc32 = static_cast<std::uint32_t>(
+      ::crc32(::crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(text.data()), static_cast<uInt>(text.size())));
+  return true;
 }
 
 std::string describe_rig_config_keys() {

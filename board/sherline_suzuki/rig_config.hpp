@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -24,6 +25,7 @@ struct RigConfig {
   std::array<double, 3> work_offset_mm = kHomeWorldMm;  // the tool tip in the part's frame with the machine at home
   std::string output_folder;        // where journals go by default ("": the current folder)
   CommissioningSettings commissioning;
+  std::uint32_t file_crc32 = 0;     // the file's CRC-32, recorded with a job (0: the compiled-in rig)
 };
 
 // Reads `text` (named `source` in messages) over the defaults in `config`. False with `error` naming
@@ -33,8 +35,9 @@ struct RigConfig {
 [[nodiscard]] bool parse_rig_config(std::string_view text, const std::string& source, RigConfig& config,
                                     std::string& error);
 
-// The file at `path`: refused first when a user other than this process's own or root owns it or can
-// write to it (group- or world-writable), since what it says decides where a real tool goes.
+// The file at `path`: refused first when it is a symbolic link, when a user other than this process's
+// own or root owns it or can write to it (group- or world-writable), or when its folder lets others
+// replace it, since what it says decides where a real tool goes.
 [[nodiscard]] bool read_rig_config(const std::string& path, RigConfig& config, std::string& error);
 
 // The allowed keys, one line each with type, unit and range (for --help and README).

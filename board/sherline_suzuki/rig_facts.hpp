@@ -91,7 +91,8 @@ inline constexpr RigFacts kRig{
               .heartbeat_output = 5,
               .heartbeat_period_ns = 400'000'000,  // the relay drops after about 1 s without a change
               .home_switch_closed_level = {true, true, true},
-              .channel_lines_latch_data = true},
+              .channel_lines_latch_data = true,
+              .step_direction = {1, 1, 1}},
     .homing_speed_mm_per_s = 1.25,
     .homing_slow_speed_mm_per_s = 0.3125,
     .homing_chunk_mm = 0.1,

@@ -15,19 +15,50 @@ std::string span(char axis, double low, double high) {
   return text;
 }
 
+// The tip's travel on `axis`, world mm: machine 0..travel counts from the home's world position along
+// machine_sign; a tool that sticks out further than the touch-off's sits lower.
+void travel_of(int axis, const RigFacts& facts, const TableFitJob& job, double& low, double& high) {
+  const auto a = static_cast<std::size_t>(axis);
+  const double lower_tip = axis == 2 ? job.tool_stick_out_mm - job.reference_stick_out_mm : 0.0;
+  const double home = job.home_world_mm[a] - lower_tip;
+  const double far = home + facts.machine_sign[a] * facts.workspace_mm[a];
+  low = std::min(home, far);
+  high = std::max(home, far);
+}
+
 }  // namespace
+
+void configured_travel(const RigFacts& facts, const TableFitJob& job, std::array<double, 3>& low_mm,
+                       std::array<double, 3>& high_mm) {
+  for (int axis = 0; axis < 3; ++axis) {
+    travel_of(axis, facts, job, low_mm[static_cast<std::size_t>(axis)], high_mm[static_cast<std::size_t>(axis)]);
+  }
+}
+
+bool check_stock_fit(const std::array<double, 3>& low_mm, const std::array<double, 3>& high_mm, const RigFacts& facts,
+                     const TableFitJob& job, std::string& error) {
+  for (int axis = 0; axis < 3; ++axis) {
+    const auto a = static_cast<std::size_t>(axis);
+    double travel_low = 0.0, travel_high = 0.0;
+    travel_of(axis, facts, job, travel_low, travel_high);
+    if (low_mm[a] < travel_low - kSlackMm || high_mm[a] > travel_high + kSlackMm) {
+      error = "the stock spans " + span(static_cast<char>('x' + axis), low_mm[a], high_mm[a]) +
+              "; the configured travel reaches " + span(static_cast<char>('x' + axis), travel_low, travel_high) +
+              " (machine.travel_mm from the work offset)";
+      return false;
+    }
+  }
+  return true;
+}
 
 bool check_tables_fit(const tables::TableHeader& header, const std::string& tables_name, const RigFacts& facts,
                       const TableFitJob& job, std::string& error) {
-  const double lower_tip = job.tool_stick_out_mm - job.reference_stick_out_mm;  // a longer tool sits lower
   for (int axis = 0; axis < 3; ++axis) {
     const auto a = static_cast<std::size_t>(axis);
     const char name = static_cast<char>('x' + axis);
     const double part_low = header.part_min_mm[a], part_high = header.part_max_mm[a];
-    // Machine 0..travel counts from the home's world position along machine_sign.
-    const double home = job.home_world_mm[a] - (axis == 2 ? lower_tip : 0.0);
-    const double far = home + facts.machine_sign[a] * facts.workspace_mm[a];
-    const double travel_low = std::min(home, far), travel_high = std::max(home, far);
+    double travel_low = 0.0, travel_high = 0.0;
+    travel_of(axis, facts, job, travel_low, travel_high);
     if (part_low < travel_low - kSlackMm || part_high > travel_high + kSlackMm) {
       error = tables_name + ": the part spans " + span(name, part_low, part_high) + "; the configured travel reaches " +
               span(name, travel_low, travel_high) + " (machine.travel_mm from the work offset)";

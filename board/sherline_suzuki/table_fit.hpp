@@ -20,4 +20,13 @@ struct TableFitJob {
 [[nodiscard]] bool check_tables_fit(const tables::TableHeader& header, const std::string& tables_name,
                                     const RigFacts& facts, const TableFitJob& job, std::string& error);
 
+// Where the tool tip can go, world mm: the configured travel from the work offset, per axis.
+void configured_travel(const RigFacts& facts, const TableFitJob& job, std::array<double, 3>& low_mm,
+                       std::array<double, 3>& high_mm);
+
+// The stock block (world mm) inside the configured travel from the work offset: false with `error`
+// naming the axis, the stock's extent and the travel's.
+[[nodiscard]] bool check_stock_fit(const std::array<double, 3>& low_mm, const std::array<double, 3>& high_mm,
+                                   const RigFacts& facts, const TableFitJob& job, std::string& error);
+
 }  // namespace stencil::board::sherline_suzuki

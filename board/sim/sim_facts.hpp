@@ -60,8 +60,9 @@ inline constexpr hal::MonotonicNs kWatchdogRelayNs = rig::kRig.watchdog_relay_ti
 // The simulated Sherline mill: the rig's steps, backlash, hard stops and home switches (`truth`: the
 // mill as it is, which a test may make differ from what the controller's configuration `believed`
 // says); it powers up in mid-workspace with the slack on the negative side (as after a positive
-// move), so that homing has a way to go on every axis. An axis whose configured sign disagrees with
-// the truth runs the other way from what the controller commands, as a motor wired backwards does.
+// move), so that homing has a way to go on every axis. Its direction lines are wired as the truth's
+// step_direction says: where the configuration says otherwise, that axis runs the other way from
+// what the driver commands.
 inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth, const rig::RigFacts& believed) {
   stencil::sim::MillConfig config{};
   config.steps_per_mm = truth.steps_per_mm;
@@ -73,8 +74,9 @@ inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth
     c.travel_max_steps = rig::mm_to_steps(rig::travel_max_mm(axis, truth), truth);
     c.home_switch_edge_steps = rig::mm_to_steps(truth.home_switch_edge_mm, truth);
     c.initial_position_steps = rig::mm_to_steps(truth.workspace_mm[a] / 2.0, truth);
-    c.motor_direction = truth.machine_sign[a] == believed.machine_sign[a] ? 1 : -1;
+    c.motor_direction = truth.mmc4s.step_direction[a];  // the mill's direction lines as they are wired
   }
+  static_cast<void>(believed);  // the driver applies the configured wiring on its side of the line
   return config;
 }
 inline constexpr stencil::sim::MillConfig kMillConfig = mill_config(rig::kRig, rig::kRig);
@@ -87,8 +89,10 @@ inline constexpr hal::cy545::Cy545Config link_config(bool realtime, const rig::R
   hal::cy545::Cy545Config config = rig::cy545_config(facts);
   // Homing at 25 times the rig's approach rate and 10 times its edge-finding rate: the simulated mill
   // has no inertia to overrun its switch with, and every job starts by homing from mid-travel.
-  config.motion.homing_rate = 25 * config.motion.homing_rate;
-  config.motion.homing_slow_rate = 10 * config.motion.homing_slow_rate;
+  // (At most the chip's 27000 steps/s, whatever rates a configuration gives.)
+  config.motion.homing_rate = 25 * config.motion.homing_rate < 27000U ? 25 * config.motion.homing_rate : 27000U;
+  config.motion.homing_slow_rate =
+      10 * config.motion.homing_slow_rate < 27000U ? 10 * config.motion.homing_slow_rate : 27000U;
   // The simulated rig takes the thesis's reading of the MMC-4S (an address latch: one select a change
   // of axis): the per-line reading's extra commands cost the mill much of its throughput (the demo
   // job: 0.93 % -> 5.4 % uncut). The driver is held to the per-line board by its own tests.

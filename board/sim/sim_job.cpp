@@ -37,6 +37,7 @@ motion::MachineFrames frames(const SimRig& rig) {
 motion::MachineFrames true_frames(const SimRig& rig) {
   motion::MachineFrames truth = frames(rig);
   truth.steps_per_mm = rig.mill_truth.steps_per_mm;
+  truth.machine_sign = rig.mill_truth.machine_sign;
   return truth;
 }
 

@@ -165,7 +165,7 @@ struct SimResult {
 
 // The simulation board's device -> world -> machine frames (above), as the controller believes them.
 [[nodiscard]] motion::MachineFrames frames(const SimRig& rig = {});
-// The same with the simulated mill's true steps per mm: where the mill's steps really put the tool.
+// The same with the simulated mill's true steps per mm and axis signs: where its steps really put the tool.
 [[nodiscard]] motion::MachineFrames true_frames(const SimRig& rig);
 
 // The default stock for a part: its bounding box grown by 2 mm on each side in x and y (within the

@@ -20,7 +20,7 @@ class SimulatedMachinist final : public sherline_suzuki::CommissioningOperator {
   bool reading(int axis, const std::string& question, const std::function<void()>&, double& mm) override {
     const auto a = static_cast<std::size_t>(axis);
     const auto steps = mill_.mill().axis_position_steps(static_cast<stencil::sim::Axis>(axis));
-    const double world = rig_.facts.machine_sign[a] * static_cast<double>(steps) / rig_.mill_truth.steps_per_mm;
+    const double world = rig_.mill_truth.machine_sign[a] * static_cast<double>(steps) / rig_.mill_truth.steps_per_mm;
     mm = std::round(world * 1000.0) / 1000.0 + 0.0;  // no -0.000
     char answer[64];
     std::snprintf(answer, sizeof answer, " -> %.3f (the simulated machinist)", mm);

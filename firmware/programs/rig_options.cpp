@@ -8,6 +8,7 @@
 
 #include "board/sherline_suzuki/rig_facts.hpp"
 #include "board/sherline_suzuki/rig_devices.hpp"
+#include "board/sherline_suzuki/table_fit.hpp"
 #include "firmware/programs/output_probe.hpp"
 
 namespace stencil::app {
@@ -80,7 +81,10 @@ void add_record_options(CLI::App& app, RigOptions& o) {
       ->check(CLI::NonNegativeNumber);
 }
 
-bool read_stock(const std::array<double, 3>& workspace, const std::string& text, control::StockBlock& stock,
+// The stock: by default the whole workspace [0, travel] (checked against the travel from the work
+// offset once the tables are in), else inside that travel.
+bool read_stock(const std::array<double, 3>& workspace, const std::array<double, 3>& low,
+                const std::array<double, 3>& high, const std::string& text, control::StockBlock& stock,
                 std::string& error) {
   stock = {{0.0, 0.0, 0.0}, {workspace[0], workspace[1], workspace[2]}};
   if (text.empty()) {
@@ -90,13 +94,14 @@ bool read_stock(const std::array<double, 3>& workspace, const std::string& text,
   bool inside = parse_numbers(text, numbers, 6);
   for (int axis = 0; inside && axis < 3; ++axis) {
     const auto a = static_cast<std::size_t>(axis);
-    inside = numbers[a] >= 0.0 && numbers[a] < numbers[a + 3] && numbers[a + 3] <= workspace[a];
+    inside = numbers[a] >= low[a] && numbers[a] < numbers[a + 3] && numbers[a + 3] <= high[a];
   }
   if (!inside) {
-    char workspace_text[96];
-    std::snprintf(workspace_text, sizeof workspace_text, "[0,%g]x[0,%g]x[0,%g]", workspace[0], workspace[1], workspace[2]);
+    char workspace_text[160];
+    std::snprintf(workspace_text, sizeof workspace_text, "[%g,%g]x[%g,%g]x[%g,%g]", low[0], high[0], low[1], high[1],
+                  low[2], high[2]);
     error = "--stock " + text + ": expected X0,Y0,Z0,X1,Y1,Z1 in mm with each high above its low, inside the workspace " +
-            workspace_text;
+            workspace_text + " (the travel from the work offset)";
     return false;
   }
   stock = {{numbers[0], numbers[1], numbers[2]}, {numbers[3], numbers[4], numbers[5]}};
@@ -133,7 +138,10 @@ bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& 
   offset.home_world_mm = Eigen::Vector3d(numbers[0], numbers[1], numbers[2]);
   offset.tool_stick_out_mm = o.stick_out;
   offset.reference_stick_out_mm = o.reference_stick_out;
-  if (!read_stock(o.config.facts.workspace_mm, o.stock_text, stock, error) || (!o.report_path.empty() && !probe_writable(o.report_path, error))) {
+  std::array<double, 3> low{}, high{};
+  board::sherline_suzuki::configured_travel(
+      o.config.facts, {{numbers[0], numbers[1], numbers[2]}, o.stick_out, o.reference_stick_out}, low, high);
+  if (!read_stock(o.config.facts.workspace_mm, low, high, o.stock_text, stock, error) || (!o.report_path.empty() && !probe_writable(o.report_path, error))) {
     return false;
   }
   if (!board::sherline_suzuki::is_haptic_link_name(o.haptic)) {

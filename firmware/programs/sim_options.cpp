@@ -171,6 +171,8 @@ bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
     o.rig.home_world_mm = config.work_offset_mm;
     o.rig.mill_truth = config.facts;
     o.commissioning = config.commissioning;
+    o.config_crc32 = config.file_crc32;
+    o.output_folder = config.output_folder;
     if (app.count("--priority") == 0) o.priority = config.cycle_priority;
     if (app.count("--cpu") == 0) o.cpu = config.cycle_cpu;
   }
@@ -181,6 +183,7 @@ bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
       return false;
     }
     o.rig.mill_truth = truth.facts;
+    o.mill_truth_crc32 = truth.file_crc32;
   }
   return true;
 }

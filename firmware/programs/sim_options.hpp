@@ -20,6 +20,8 @@ struct SimOptions {
   board::sim::SimRig rig;       // both, read by apply_sim_config
   bool commission = false;      // --commission: commissioning on the simulated rig instead of a job
   board::sherline_suzuki::CommissioningSettings commissioning;  // the file's [commissioning]
+  std::uint32_t config_crc32 = 0, mill_truth_crc32 = 0;          // the files', for the journal's job (0: none)
+  std::string output_folder;                                     // the file's job.output_folder
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
   std::string pattern_name = "raster";

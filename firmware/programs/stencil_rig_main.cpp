@@ -46,14 +46,19 @@ std::atomic<bool> interrupted{false};
 void on_signal(int) { interrupted.store(true); }
 
 // What makes the job the same job when it is resumed: recorded at its start, checked on resume.
-std::string job_text_of(const board::sherline_suzuki::WorkOffset& offset, const control::StockBlock& stock) {
-  char text[300];
+// The rig's configuration counts too: a job resumed under another file would read its steps through
+// other frames.
+std::string job_text_of(const board::sherline_suzuki::WorkOffset& offset, const control::StockBlock& stock,
+                        std::uint32_t config_crc32) {
+  char text[340];
   std::snprintf(text, sizeof text,
                 "work-offset=%.6f,%.6f,%.6f tool-stick-out=%.6f reference-stick-out=%.6f stock=%.6f,%.6f,%.6f,%.6f,%.6f,%.6f",
                 offset.home_world_mm.x(), offset.home_world_mm.y(), offset.home_world_mm.z(), offset.tool_stick_out_mm,
                 offset.reference_stick_out_mm, stock.low_mm.x(), stock.low_mm.y(), stock.low_mm.z(), stock.high_mm.x(),
                 stock.high_mm.y(), stock.high_mm.z());
-  return text;
+  char config[48];
+  std::snprintf(config, sizeof config, config_crc32 == 0 ? " config=compiled-in" : " config-crc32=%08x", config_crc32);
+  return std::string(text) + config;
 }
 
 // The journal as asked: a fresh one, none, or (--resume) the job's own once it is found to be this
@@ -68,7 +73,7 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
   request.resume_path = o.resume_path;
   request.start.tables_crc32 = part.header.crc32;
   request.start.triangle_count = part.header.triangle_count;
-  request.start.job = job_text_of(job.offset, job.stock);
+  request.start.job = job_text_of(job.offset, job.stock, o.config.file_crc32);
   if (!o.resume_path.empty()) {
     journal::JobHistory history;
     if (!journal::read_job_history(o.resume_path, part.header.crc32, part.header.triangle_count,
@@ -237,7 +242,10 @@ int main(int argc, char** argv) {
   const board::sherline_suzuki::TableFitJob fit{
       {job.offset.home_world_mm.x(), job.offset.home_world_mm.y(), job.offset.home_world_mm.z()},
       job.offset.tool_stick_out_mm, job.offset.reference_stick_out_mm};
-  if (!board::sherline_suzuki::check_tables_fit(part.header, o.tables_path, job.facts, fit, error)) {
+  if (!board::sherline_suzuki::check_tables_fit(part.header, o.tables_path, job.facts, fit, error) ||
+      !board::sherline_suzuki::check_stock_fit({job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z()},
+                                               {job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z()},
+                                               job.facts, fit, error)) {
     return fail(kExitBadInput, error);
   }
   job.overrun_limit = job.facts.overrun_limit;

@@ -273,9 +273,13 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
                 job.stock.low_mm.z(), job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
   job_text = "tables=" + (o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path) +
              " operator=" + (o.operator_path.empty() ? std::string("-") : o.operator_path) +
-             " pattern=" + (o.operator_path.empty() ? o.pattern_name : std::string("-")) + numbers +
-             (o.config_path.empty() ? std::string() : " config=" + o.config_path) +
-             (o.mill_truth_path.empty() ? std::string() : " mill-truth=" + o.mill_truth_path);
+             " pattern=" + (o.operator_path.empty() ? o.pattern_name : std::string("-")) + numbers;
+  // A configured rig (and a mill truth of its own) make it another job; the compiled-in rig's text is as before.
+  char files[64] = "";
+  if (o.config_crc32 != 0 || o.mill_truth_crc32 != 0) {
+    std::snprintf(files, sizeof files, " config-crc32=%08x mill-truth-crc32=%08x", o.config_crc32, o.mill_truth_crc32);
+  }
+  job_text += files;
   if (job_text.size() > 1024) {
     error = "--tables and --operator: paths too long to record in the journal (" + std::to_string(job_text.size()) +
             " bytes of the job; at most 1024)";
@@ -468,7 +472,10 @@ int main(int argc, char** argv) {
   std::string job_text;
   if (!app::check_sim_options(app, o, error) || !app::apply_sim_config(app, o, error) ||
       !load_part(o.tables_path, file_bytes, part, error) || !fits_the_rig(o, part, error) ||
-      !make_job(o, part, job, job_text, error)) {
+      !make_job(o, part, job, job_text, error) ||
+      !board::sherline_suzuki::check_stock_fit({job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z()},
+                                               {job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z()},
+                                               o.rig.facts, {o.rig.home_world_mm, 0.0, 0.0}, error)) {
     return bad_input(error);
   }
   if (o.commission) {
@@ -480,6 +487,7 @@ int main(int argc, char** argv) {
   journal::JobJournalRequest request;
   request.program = "stencil-sim";
   request.path = o.journal_path;
+  request.folder = o.output_folder;
   request.none = o.no_journal;
   request.resume_path = o.resume_path;
   request.start.tables_crc32 = part.header.crc32;

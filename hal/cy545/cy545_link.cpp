@@ -427,7 +427,7 @@ Cy545Link::SwitchReading Cy545Link::read_home_switch(std::size_t axis, Monotonic
   return closed == reads ? SwitchReading::Closed : closed == 0 ? SwitchReading::Open : SwitchReading::Bouncing;
 }
 
-bool Cy545Link::homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns) {
+bool Cy545Link::homing_leg(std::size_t axis, std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns) {
   CommandBytes command{};
   // Homing takes minutes: the watchdog must not drop meanwhile. A heartbeat sent moved the address
   // lines and the read strobe: the home switch goes back on the input line.
@@ -446,12 +446,13 @@ bool Cy545Link::homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs d
     rate_sent_ = rate;
   }
   const auto count = static_cast<std::uint32_t>(std::abs(steps));
+  const std::int64_t chip_steps = static_cast<std::int64_t>(steps) * chip_sign(axis);  // the direction line's wiring
   if (!number_command('N', count, kMax24, command) || !send(command, deadline_ns) ||
-      !bare_command(steps > 0 ? '+' : '-', command) || !send(command, deadline_ns) || !bare_command('G', command) ||
+      !bare_command(chip_steps > 0 ? '+' : '-', command) || !send(command, deadline_ns) || !bare_command('G', command) ||
       !send(command, deadline_ns)) {
     return false;
   }
-  position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + steps) & kMax24;
+  position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + chip_steps) & kMax24;
   const MonotonicNs leg = steps_time_ns(count, rate);
   started_running(leg, leg + config_.pace_margin_ns);
   return true;
@@ -483,7 +484,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(chunk, config_.motion.homing_rate, deadline_ns)) {
+    if (!homing_leg(axis, chunk, config_.motion.homing_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, debounce);
@@ -495,14 +496,14 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
     }
     if (travelled >= config_.motion.homing_travel_steps) {
       std::snprintf(last_error_, sizeof last_error_,
-                    "homing axis %c: no home switch within %d steps of travel moving -: check the axis sign "
-                    "(machine.axis_sign: a motor that runs the other way never reaches it), the switch, its wiring "
-                    "and its closed level in the configuration",
+                    "homing axis %c: no home switch within %d steps of travel moving -: check its step direction "
+                    "(machine.board.step_direction: a motor that runs the other way never reaches it), the switch, "
+                    "its wiring and its closed level in the configuration",
                     name, travelled);
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(-chunk, config_.motion.homing_rate, deadline_ns)) {
+    if (!homing_leg(axis, -chunk, config_.motion.homing_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, debounce);
@@ -523,7 +524,7 @@ bool Cy545Link::home_axis(std::size_t axis, MonotonicNs deadline_ns) {
       latch_fault(MachineFault::PositionMismatch);
       return false;
     }
-    if (!homing_leg(1, config_.motion.homing_slow_rate, deadline_ns)) {
+    if (!homing_leg(axis, 1, config_.motion.homing_slow_rate, deadline_ns)) {
       return false;
     }
     reading = read_home_switch(axis, deadline_ns, 1);
@@ -641,14 +642,15 @@ MachineResult Cy545Link::move(const MachineTarget& target, MonotonicNs deadline_
       continue;
     }
     const auto steps = static_cast<std::uint32_t>(std::abs(delta));
+    const std::int64_t chip_delta = delta * chip_sign(axis);  // the direction line's wiring
     if (!select_channel(config_.wiring.motor_channel[axis], deadline_ns) ||
         !number_command('N', steps, kMax24, command) || !send(command, deadline_ns) ||
-        !bare_command(delta > 0 ? '+' : '-', command) || !send(command, deadline_ns) ||
+        !bare_command(chip_delta > 0 ? '+' : '-', command) || !send(command, deadline_ns) ||
         !bare_command('G', command) || !send(command, deadline_ns)) {
       return {false, fault_ == MachineFault::None ? MachineRefusal::DeadlineTooShort : MachineRefusal::None, fault_};
     }
     commanded_[axis] = target.motor_steps[axis];
-    position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + delta) & kMax24;
+    position_register_ = static_cast<std::uint32_t>(static_cast<std::int64_t>(position_register_) + chip_delta) & kMax24;
     const MonotonicNs leg = steps_time_ns(steps, config_.motion.step_rate);
     started_running(leg, leg + config_.pace_margin_ns);
   }

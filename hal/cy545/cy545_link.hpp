@@ -136,8 +136,10 @@ class Cy545Link final : public MachineLink {
   // The selected home input read `reads` times: Open or Closed when all agree.
   SwitchReading read_home_switch(std::size_t axis, MonotonicNs deadline_ns, int reads);
   // One homing leg on the selected channel: `steps` (signed) at `rate`, then waits for the chip.
-  bool homing_leg(std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns);
+  bool homing_leg(std::size_t axis, std::int32_t steps, std::uint32_t rate, MonotonicNs deadline_ns);
   bool home_axis(std::size_t axis, MonotonicNs deadline_ns);
+  // +1 or -1: how the chip's '+' moves this axis (Mmc4sWiring::step_direction; anything else is +1).
+  [[nodiscard]] std::int64_t chip_sign(std::size_t axis) const { return config_.wiring.step_direction[axis] < 0 ? -1 : 1; }
   [[nodiscard]] bool abort_asked() const { return abort_ != nullptr && abort_->load(std::memory_order_relaxed); }
   MachineResult aborted(MonotonicNs deadline_ns);
 

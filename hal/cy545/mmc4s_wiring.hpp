@@ -30,6 +30,10 @@ struct Mmc4sWiring {
   // address (the thesis's table 5-1: output ports 0-3 are "motor/driver addresses"), one select.
   // Measure it at commissioning: select X, then Y, step, and see whether X moves.
   bool channel_lines_latch_data;
+  // Per axis x y z, the motor driver's direction line: +1, the chip's '+' steps move the axis away from
+  // its home switch (into the workspace); -1, the line is wired the other way round, and the driver
+  // sends '-' for those. Wrong, homing runs away from the switch and finds none.
+  std::array<int, 3> step_direction;
 
   bool operator==(const Mmc4sWiring&) const = default;
 };

@@ -48,7 +48,7 @@ struct Bench {
 // answer otherwise; stops answering after `answers` readings when that is not negative.
 class ScriptedMachinist final : public rig::CommissioningOperator {
  public:
-  ScriptedMachinist(const Bench& bench, double true_steps_per_mm) : bench_(bench), steps_per_mm_(true_steps_per_mm) {}
+  ScriptedMachinist(const Bench& bench, const rig::RigFacts& truth) : bench_(bench), truth_(truth) {}
 
   void say(const std::string& line) override { said.push_back(line); }
   bool reading(int axis, const std::string& question, const std::function<void()>& idle, double& mm) override {
@@ -57,8 +57,8 @@ class ScriptedMachinist final : public rig::CommissioningOperator {
     if (answers == 0) return false;
     --answers;
     const auto steps = bench_.mill.axis_position_steps(static_cast<sim::Axis>(axis));
-    const double world = flip * bench_.configured.machine_sign[static_cast<std::size_t>(axis)] *
-                         static_cast<double>(steps) / steps_per_mm_;
+    const double world = flip * truth_.machine_sign[static_cast<std::size_t>(axis)] * static_cast<double>(steps) /
+                         truth_.steps_per_mm;
     mm = std::round(world * 1000.0) / 1000.0;  // a dial indicator's 0.001 mm
     return true;
   }
@@ -69,7 +69,7 @@ class ScriptedMachinist final : public rig::CommissioningOperator {
 
  private:
   const Bench& bench_;
-  double steps_per_mm_;
+  rig::RigFacts truth_;
 };
 
 bool any_contains(const std::vector<std::string>& lines, const std::string& part) {
@@ -85,7 +85,7 @@ TEST_GROUP(Commissioning){};
 
 TEST(Commissioning, a_configuration_that_agrees_with_the_mill_passes_and_measures_its_backlash) {
   Bench bench(rig::kRig, rig::kRig);
-  ScriptedMachinist machinist(bench, rig::kRig.steps_per_mm);
+  ScriptedMachinist machinist(bench, rig::kRig);
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_TRUE(result.homed);
   CHECK_TEXT(result.passed, result.findings.empty() ? "" : result.findings[0].c_str());
@@ -99,22 +99,48 @@ TEST(Commissioning, a_configuration_that_agrees_with_the_mill_passes_and_measure
   CHECK_FALSE(bench.mill.drivers_enabled());
 }
 
-TEST(Commissioning, an_axis_sign_the_mill_does_not_have_is_stopped_by_homing_before_any_jog) {
+TEST(Commissioning, a_step_direction_the_mill_does_not_have_is_stopped_by_homing_before_any_jog) {
   rig::RigFacts truth = rig::kRig;
-  truth.machine_sign[0] = 1;
+  truth.mmc4s.step_direction[0] = -1;  // X's direction line wired the other way round
   Bench bench(rig::kRig, truth);
-  ScriptedMachinist machinist(bench, truth.steps_per_mm);
+  ScriptedMachinist machinist(bench, truth);
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_FALSE(result.homed);
   CHECK_FALSE(result.passed);
-  CHECK(any_contains(result.findings, "homing axis X: no home switch within 40960 steps of travel moving -: check the axis sign"));
+  CHECK(any_contains(result.findings,
+                     "homing axis X: no home switch within 40960 steps of travel moving -: check its step direction"));
   CHECK(machinist.questions.empty());
   CHECK_FALSE(bench.mill.drivers_enabled());
 }
 
+// The sign that maps the mill's axis onto the part (which way the table moves) is no matter to
+// homing: the indicator finds it.
+TEST(Commissioning, an_axis_sign_the_mill_does_not_have_is_found_by_the_indicator) {
+  rig::RigFacts truth = rig::kRig;
+  truth.machine_sign[1] = 1;
+  Bench bench(rig::kRig, truth);
+  ScriptedMachinist machinist(bench, truth);
+  const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
+  CHECK_TRUE(result.homed);
+  CHECK_FALSE(result.passed);
+  CHECK(any_contains(result.findings, "axis Y: moved +5.000 mm along the part's axis for -5.000 commanded: it runs the "
+                                      "other way (or not at all); check machine.axis_sign"));
+  CHECK_FALSE(any_contains(result.findings, "axis X"));
+}
+
+// A configured step direction of -1 is driven as such: the driver sends '-' where the mill's line is reversed.
+TEST(Commissioning, a_reversed_direction_line_configured_as_such_passes) {
+  rig::RigFacts reversed = rig::kRig;
+  reversed.mmc4s.step_direction = {-1, 1, -1};
+  Bench bench(reversed, reversed);
+  ScriptedMachinist machinist(bench, reversed);
+  const rig::CommissioningResult result = rig::commission(reversed, {}, bench.link, bench.clock, machinist, nullptr);
+  CHECK_TEXT(result.passed, result.findings.empty() ? "" : result.findings[0].c_str());
+}
+
 TEST(Commissioning, an_axis_read_going_the_other_way_is_named) {
   Bench bench(rig::kRig, rig::kRig);
-  ScriptedMachinist machinist(bench, rig::kRig.steps_per_mm);
+  ScriptedMachinist machinist(bench, rig::kRig);
   machinist.flip = -1.0;
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_FALSE(result.passed);
@@ -127,18 +153,28 @@ TEST(Commissioning, steps_per_mm_one_percent_off_are_measured) {
   truth.steps_per_mm = 646.4;
   truth.backlash_mm = {80 / 646.4, 32 / 646.4, 80 / 646.4};
   Bench bench(rig::kRig, truth);
-  ScriptedMachinist machinist(bench, truth.steps_per_mm);
+  ScriptedMachinist machinist(bench, truth);
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_FALSE(result.passed);
   CHECK(any_contains(result.findings, "axis Y: moved 4.950 mm for 5.000 mm commanded (-1.00 %): machine.steps_per_mm "
                                       "would be 646.46; the file says 640"));
 }
 
+TEST(Commissioning, a_backlash_within_the_indicators_tolerance_passes_with_its_line) {
+  rig::RigFacts truth = rig::kRig;
+  truth.backlash_mm[0] = 0.125 + 5.0 / 640.0;  // 5 steps, 7.8 um: under the 0.02 mm tolerance
+  Bench bench(rig::kRig, truth);
+  ScriptedMachinist machinist(bench, truth);
+  const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
+  CHECK_TEXT(result.passed, result.findings.empty() ? "" : result.findings[0].c_str());
+  STRCMP_EQUAL("backlash_mm = [0.1328125, 0.05, 0.125]", result.backlash_line.c_str());
+}
+
 TEST(Commissioning, more_backlash_than_the_file_says_is_proposed_as_the_line_to_write) {
   rig::RigFacts truth = rig::kRig;
   truth.backlash_mm[1] = 0.1;  // 64 steps
   Bench bench(rig::kRig, truth);
-  ScriptedMachinist machinist(bench, truth.steps_per_mm);
+  ScriptedMachinist machinist(bench, truth);
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_FALSE(result.passed);
   STRCMP_EQUAL("backlash_mm = [0.125, 0.1, 0.125]", result.backlash_line.c_str());
@@ -147,7 +183,7 @@ TEST(Commissioning, more_backlash_than_the_file_says_is_proposed_as_the_line_to_
 
 TEST(Commissioning, no_reading_ends_it_with_the_mill_stopped) {
   Bench bench(rig::kRig, rig::kRig);
-  ScriptedMachinist machinist(bench, rig::kRig.steps_per_mm);
+  ScriptedMachinist machinist(bench, rig::kRig);
   machinist.answers = 1;  // the X axis's reading at home, then nothing
   const rig::CommissioningResult result = rig::commission(rig::kRig, {}, bench.link, bench.clock, machinist, nullptr);
   CHECK_FALSE(result.passed);

@@ -707,7 +707,7 @@ case_refuses_an_unknown_pattern() {
 
 # The rig's configuration file: each bad file refused with the file, the line and the key (or both
 # numbers), exit status 2, before anything is opened (nothing printed about the tables, the host or
-# the devices; the serial port named in the file is a FIFO nobody reads, which an open would block on).
+# the devices: each of those prints a line once it is looked at).
 config_with() {  # KEY LINE: the example with the line starting "KEY =" replaced ("" removes it)
   awk -v key="$1" -v line="$2" 'index($0, key " =") == 1 && !done { done = 1; if (line != "") print line; next } { print }' \
     "$repo/board/sherline_suzuki/rig.toml" >rig.toml
@@ -725,18 +725,20 @@ case_rig_refuses_a_bad_configuration() {
   mkdir -p parts && "$(dirname "$sim")/stencil-sample-parts" parts >/dev/null || fail "stencil-sample-parts failed"
   "$(dirname "$sim")/stencil-tablegen" parts/hex_prism.stl -o part.stbl --tool ball:d=3 --quiet 2>/dev/null ||
     fail "stencil-tablegen failed"
-  mkfifo port
-  config_with serial_port "serial_port = \"$PWD/port\""
+  config_with serial_port "serial_port = \"$PWD/file_port\""
   cp rig.toml good.toml
   config_with serial_baud $'serial_baud = 57600\nsteps_per_inch = 16000'
-  refused_config "rig.toml:12: unknown key 'machine.steps_per_inch'" "the unknown key with its line"
+  local line
+  line=$(grep -n '^steps_per_inch =' rig.toml | cut -d: -f1)
+  refused_config "rig.toml:$line: unknown key 'machine.steps_per_inch'" "the unknown key with its line"
   config_with update_hz "update_hz = 0.5"
   refused_config "rig.toml:[0-9]+: machine.update_hz: 0.5 is out of range: expected a number from 1 to 200" "the range"
   config_with force_limit_n "force_limit_n = 50.0"
   refused_config "rig.toml:[0-9]+: haptic.force_limit_n: 50 is out of range: expected a number from 0.5 to 5 \(N, at most the board's 5 N" \
     "the force ceiling no file raises"
   config_with serial_port ""
-  refused_config "rig.toml: missing the key 'machine.serial_port'" "the missing serial port"
+  refused_config "rig.toml:$(grep -n '^\[machine\]' rig.toml | cut -d: -f1): \[machine\]: missing the key 'machine.serial_port'" \
+    "the missing serial port, at its section's line"
   install -m 666 good.toml rig.toml
   refused_config "rig.toml: writable by other users \(mode 0666\)" "the world-writable file"
   install -m 600 good.toml rig.toml && sed -i 's/^travel_mm = \[50.0, 25.0, 25.0\]/travel_mm = [20.0, 25.0, 25.0]/' rig.toml
@@ -744,6 +746,9 @@ case_rig_refuses_a_bad_configuration() {
   refused_config "part.stbl: the part spans x [0-9.]+ to [0-9.]+ mm; the configured travel reaches x 30 to 50 mm" \
     "the part outside the configured travel, both numbers"
   install -m 600 good.toml rig.toml && : >not_a_tty
+  run_rig --config rig.toml --tables part.stbl
+  expect_status 3
+  expect_stderr "the mill's CY545: .*file_port" "the file's serial port, opened once everything was checked"
   run_rig --config rig.toml --tables part.stbl --serial not_a_tty
   expect_status 3
   expect_stderr "not_a_tty: not a serial port" "the command line's port over the file's"
@@ -765,29 +770,35 @@ case_example_configuration_gives_the_same_report() {
   fi
 }
 
-# A configuration wrong against the simulated mill: an X sign the mill does not have is stopped by
-# homing (the job never starts, nothing is cut) and by commissioning; steps per mm 1 % off are found by
-# commissioning's measured move, which says what the file should say.
+# A configuration wrong against the simulated mill: X's motor direction the other way round is stopped
+# by homing (the job never starts, nothing is cut) and by commissioning; an axis sign (which way the
+# table moves under the tool, no matter to homing) is found by commissioning's indicator; steps per mm
+# 1 % off by its measured move, which says what the file should say.
 case_commissioning_finds_a_wrong_sign_and_wrong_steps() {
   install -m 600 "$repo/board/sherline_suzuki/rig.toml" rig.toml
+  sed 's/^step_direction = \[1, 1, 1\]/step_direction = [-1, 1, 1]/' rig.toml >direction.toml
   sed 's/^axis_sign = \[-1, -1, -1\]/axis_sign = [1, -1, -1]/' rig.toml >sign.toml
   sed -e 's/^steps_per_mm = \[640.0, 640.0, 640.0\]/steps_per_mm = [646.4, 646.4, 646.4]/' \
-    -e 's/^backlash_mm = .*/backlash_mm = [0.12376237623762376, 0.0495049504950495, 0.12376237623762376]/' rig.toml >steps.toml
-  chmod 600 sign.toml steps.toml
-  grep -q "^axis_sign = \[1, -1, -1\]" sign.toml && grep -q "^steps_per_mm = \[646.4" steps.toml ||
-    fail "the mill's truth could not be written"
+    -e 's/^backlash_mm = [^#]*/backlash_mm = [0.12376237623762376, 0.0495049504950495, 0.12376237623762376] /' rig.toml >steps.toml
+  chmod 600 direction.toml sign.toml steps.toml
+  grep -q "^step_direction = \[-1, 1, 1\]" direction.toml && grep -q "^axis_sign = \[1, -1, -1\]" sign.toml &&
+    grep -q "^steps_per_mm = \[646.4" steps.toml || fail "the mill's truth could not be written"
   run_sim --commission --config rig.toml
   expect_status 0
   grep -q "commissioning: passed" stdout.txt || fail "the example configuration did not pass on its own mill"
+  run_sim --commission --config rig.toml --mill-truth direction.toml
+  expect_status 3
+  grep -q "homing axis X: no home switch within [0-9]* steps of travel moving -: check its step direction" stdout.txt ||
+    fail "commissioning did not name the step direction"
+  grep -q "axis X moved" stdout.txt && fail "an axis was jogged after homing failed"
+  run_sim --fast --pattern raster --config rig.toml --mill-truth direction.toml --no-journal --report job.json
+  expect_status 3
+  expect_stderr "the machine did not start: homing axis X: .*check its step direction" "that homing stopped the job"
+  [ ! -e job.json ] || fail "a job that never started wrote a report"
   run_sim --commission --config rig.toml --mill-truth sign.toml
   expect_status 3
-  grep -q "homing axis X: no home switch within [0-9]* steps of travel moving -: check the axis sign" stdout.txt ||
-    fail "commissioning did not name the axis sign"
-  grep -q "axis X moved" stdout.txt && fail "an axis was jogged after homing failed"
-  run_sim --fast --pattern raster --config rig.toml --mill-truth sign.toml --no-journal --report job.json
-  expect_status 3
-  expect_stderr "the machine did not start: homing axis X: .*check the axis sign" "that homing stopped the job"
-  [ ! -e job.json ] || fail "a job that never started wrote a report"
+  grep -q "axis X: moved +5.000 mm along the part's axis for -5.000 commanded: it runs the other way (or not at all); check machine.axis_sign" stdout.txt ||
+    fail "commissioning did not find the axis sign"
   run_sim --commission --config rig.toml --mill-truth steps.toml
   expect_status 3
   grep -q "axis X: moved 4.950 mm for 5.000 mm commanded (-1.00 %): machine.steps_per_mm would be 646.46; the file says 640" stdout.txt ||
