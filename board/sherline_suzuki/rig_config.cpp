@@ -332,13 +332,20 @@ bool read_table(const toml::table& table, const std::string& prefix, Reading& re
   return true;
 }
 
+// "file:line: " of a key that was read (the file alone when it was not).
+struct Where {
+  const std::map<std::string, long>& lines;
+  const std::string& source;
+  std::string operator()(const char* name) const {
+    const auto found = lines.find(name);
+    return found == lines.end() ? source + ": " : at(source, found->second);
+  }
+};
+
 // Facts that contradict each other, or a ceiling of the hardware: "" or the message.
 std::string contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
   const RigFacts& f = c.facts;
-  const auto where = [&](const char* name) {
-    const auto found = lines.find(name);
-    return found == lines.end() ? source + ": " : at(source, found->second);
-  };
+  const Where where{lines, source};
   const double needed_rate = f.max_speed_mm_per_s * f.steps_per_mm;
   if (needed_rate > f.step_rate_steps_per_s + 1e-9) {
     return where("machine.max_speed_mm_per_s") + "machine.max_speed_mm_per_s " + number_text(f.max_speed_mm_per_s) +
@@ -372,10 +379,7 @@ std::string contradiction(const RigConfig& c, const std::map<std::string, long>&
 
 std::string homing_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
   const RigFacts& f = c.facts;
-  const auto where = [&](const char* name) {
-    const auto found = lines.find(name);
-    return found == lines.end() ? source + ": " : at(source, found->second);
-  };
+  const Where where{lines, source};
   if (f.homing_speed_mm_per_s >= f.max_speed_mm_per_s || f.homing_slow_speed_mm_per_s > f.homing_speed_mm_per_s) {
     return where("machine.homing.speed_mm_per_s") + "machine.homing.speed_mm_per_s " +
            number_text(f.homing_speed_mm_per_s) + ": expected below machine.max_speed_mm_per_s " +
@@ -414,10 +418,7 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
 
 std::string wiring_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
   const RigFacts& f = c.facts;
-  const auto where = [&](const char* name) {
-    const auto found = lines.find(name);
-    return found == lines.end() ? source + ": " : at(source, found->second);
-  };
+  const Where where{lines, source};
   if (f.mmc4s.heartbeat_output == f.mmc4s.spindle_output) {
     return where("machine.board.heartbeat_output") + "machine.board.heartbeat_output: expected another output than "
            "the spindle's";
