@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "firmware/services/report/build_version.hpp"
 #include "firmware/services/hmi/display_app.hpp"
 
 namespace {
@@ -34,6 +35,7 @@ int main(int argc, char** argv) {
       "and open http://HOST:PORT/ (with ?token=T to change parameters or reset). A display started before\n"
       "its controller waits for it; killed and started again, it shows the job again from the feed.",
       "stencil-display"};
+  app.set_version_flag("--version", report::version_text("stencil-display"));
   std::string controller, listen = "127.0.0.1:8080", token_file, assets;
   int max_clients = 16, max_connections = 64;
   app.add_option("--controller", controller, "the controller's display socket (it prints 'display link: PATH')")->required();

@@ -27,6 +27,7 @@
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
+#include "firmware/services/report/build_version.hpp"
 
 namespace {
 
@@ -214,6 +215,7 @@ int main(int argc, char** argv) {
       "'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
       "stopped (re-homing to resume the cut is not built yet).\n"
       "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened."};
+  app.set_version_flag("--version", report::version_text("stencil-rig"));
   app::RigOptions o;
   app::add_rig_options(app, o);
   try {

@@ -23,6 +23,7 @@
 #include "board/sim/fault_injection.hpp"
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
+#include "firmware/services/report/build_version.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/output_probe.hpp"
 #include "board/sherline_suzuki/table_fit.hpp"
@@ -458,6 +459,7 @@ int main(int argc, char** argv) {
       "device, the fake CY545 stepper controller on a pseudo-terminal and a simulated mill that removes\n"
       "material; reports gouges, coverage and loop timing. Exit status: 0 done, 2 bad input, 3 ended in a\n"
       "safe state."};
+  app.set_version_flag("--version", report::version_text("stencil-sim"));
   app::SimOptions o;
   app::add_sim_options(app, o);
   try {

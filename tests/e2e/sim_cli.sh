@@ -805,6 +805,18 @@ case_commissioning_finds_a_wrong_sign_and_wrong_steps() {
     fail "commissioning did not find the steps per mm 1 % off"
 }
 
+# Every program says what built it: the source's version from git at build time, the compiler, its flags.
+case_every_program_says_its_version() {
+  local program
+  for program in stencil-sim stencil-rig stencil-display stencil-tablegen stencil-sample-parts; do
+    [ -x "$(dirname "$sim")/$program" ] || continue  # stencil-display needs the page's build (Node.js)
+    run "$(dirname "$sim")/$program" --version
+    expect_status 0
+    head -n 1 stdout.txt | grep -Eq "^$program [^ ]+" || fail "$program --version: no version line"
+    grep -q "^built with GNU [0-9.]*: .*-ffp-contract=off" stdout.txt || fail "$program --version: no compiler and flags"
+  done
+}
+
 # The rig program on a machine without the rig: it checks what it can and says what is missing.
 case_rig_without_the_hardware_fails_cleanly() {
   mkdir -p parts && "$(dirname "$sim")/stencil-sample-parts" parts >/dev/null || fail "stencil-sample-parts failed"

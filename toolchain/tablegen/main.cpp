@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "firmware/services/report/build_version.hpp"
 #include "firmware/core/tables/table_format.hpp"
 #include "toolchain/tablegen/file_io.hpp"
 #include "toolchain/tablegen/input_error.hpp"
@@ -84,6 +85,7 @@ int main(int argc, char** argv) {
       "mesh for display, reachability by a vertical tool, and a CRC-32. Millimetres throughout.\n"
       "Exit status: 0 done, 2 bad input or options (nothing written), 1 anything else."};
   app.get_formatter()->column_width(34);
+  app.set_version_flag("--version", stencil::report::version_text("stencil-tablegen"));
 
   std::string part_path;
   std::string output_path;
@@ -146,6 +148,9 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp&) {
     std::cout << app.help();
+    return 0;
+  } catch (const CLI::CallForVersion&) {
+    std::cout << stencil::report::version_text("stencil-tablegen") << "\n";
     return 0;
   } catch (const CLI::ParseError& error) {
     std::cerr << "stencil-tablegen: " << error.what() << "\n(run stencil-tablegen --help for the options)\n";

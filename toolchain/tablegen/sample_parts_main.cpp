@@ -3,6 +3,7 @@
 #include <iostream>
 #include <string>
 
+#include "firmware/services/report/build_version.hpp"
 #include "toolchain/tablegen/input_error.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 
@@ -10,7 +11,12 @@ int main(int argc, char** argv) {
   using namespace stencil::tablegen;
   const std::string usage =
       "usage: stencil-sample-parts DIR            write hex_prism.stl, slotted_block.stl, thin_fin.stl into DIR\n"
-      "       stencil-sample-parts --dome N FILE  write a finely tessellated dome of about N facets (binary; open at the bottom)\n";
+      "       stencil-sample-parts --dome N FILE  write a finely tessellated dome of about N facets (binary; open at the bottom)\n"
+      "       stencil-sample-parts --version      what built it\n";
+  if (argc == 2 && std::string(argv[1]) == "--version") {
+    std::cout << stencil::report::version_text("stencil-sample-parts") << "\n";
+    return 0;
+  }
   try {
     if (argc == 2 && std::string(argv[1]) != "--help" && std::string(argv[1]) != "-h") {
       const std::string directory = argv[1];
