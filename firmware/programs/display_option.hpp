@@ -54,6 +54,7 @@ class Display {
   void end(const std::string& how);  // the displays show the job ended, with its last state
   void stop();  // closes the link, ends the display --hmi started; prints what the link did
   [[nodiscard]] control::DisplayFeed* feed();
+  [[nodiscard]] display_link::DisplayLink* link() { return link_.get(); }  // null: no display asked for
 
  private:
   std::unique_ptr<display_link::DisplayLink> link_;

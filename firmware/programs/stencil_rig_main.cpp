@@ -18,12 +18,14 @@
 #include "board/sherline_suzuki/rig_report.hpp"
 #include "board/sherline_suzuki/table_fit.hpp"
 #include "firmware/programs/display_option.hpp"
+#include "firmware/programs/rig_control.hpp"
 #include "firmware/programs/rig_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/programs/terminal_commands.hpp"
 #include "firmware/programs/terminal_machinist.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
 #include "firmware/runtime/rt_readiness.hpp"
+#include "firmware/services/display_link/display_link.hpp"
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
@@ -106,8 +108,9 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
 // The machine thread runs SCHED_FIFO below the cycle (which always preempts it) and above the
 // records thread, which stays SCHED_OTHER with the journal's writes and fsyncs: the machine's
 // updates keep their deadlines whatever the journal's disk does. Refused: it says so and runs on.
-// Nothing turns the spindle on unattended: once homed, the operator types 'start' at the terminal.
-void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& terminal) {
+// Nothing turns the spindle on unattended: once homed, the operator types 'start' at the terminal,
+// or (a service has no terminal) sends it over the controller's socket: `stencil-rig start`.
+void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& terminal, display_link::DisplayLink* link) {
   job.interrupted = &interrupted;
   job.progress = [](const std::string& line) { std::fprintf(stderr, "stencil-rig: %s\n", line.c_str()); };
   job.operator_command = [&terminal] { return terminal.command_typed(); };
@@ -117,22 +120,35 @@ void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& ter
       std::fprintf(stderr, "stencil-rig: %s\n", got.message.c_str());
     }
   };
-  job.confirm_spindle = [&terminal] {
+  job.confirm_spindle = [&terminal, link] {
     std::printf("stencil-rig: homed. Hold the handle still near the tool, then type 'start' and Enter to turn the "
-                "spindle on (Ctrl-C ends)\n");
+                "spindle on (Ctrl-C ends)%s%s\n", link != nullptr ? ", or send it: stencil-rig start --socket " : "",
+                link != nullptr ? link->socket_path().c_str() : "");
     std::fflush(stdout);
-    while (!interrupted.load()) {
-      const app::TerminalCommands::Word word = terminal.next_word();
-      if (word == app::TerminalCommands::Word::Start) {
-        return true;
-      }
-      if (word == app::TerminalCommands::Word::Closed) {
-        std::fprintf(stderr, "stencil-rig: no operator at the terminal (its input is closed): the spindle stays off\n");
-        return false;
-      }
-      usleep(100'000);
+    if (link != nullptr) {
+      link->await_start(true);
     }
-    return false;
+    bool closed_said = false;
+    bool started = false;
+    while (!interrupted.load() && !started) {
+      const app::TerminalCommands::Word word = terminal.next_word();
+      started = word == app::TerminalCommands::Word::Start || (link != nullptr && link->take_start());
+      if (!started && word == app::TerminalCommands::Word::Closed && !closed_said) {
+        if (link == nullptr) {
+          std::fprintf(stderr, "stencil-rig: no operator at the terminal (its input is closed): the spindle stays off\n");
+          return false;
+        }
+        std::fprintf(stderr, "stencil-rig: no terminal: waiting for 'stencil-rig start' on %s\n", link->socket_path().c_str());
+        closed_said = true;
+      }
+      if (!started) {
+        usleep(100'000);
+      }
+    }
+    if (link != nullptr) {
+      link->await_start(false);
+    }
+    return started;
   };
 }
 
@@ -214,14 +230,23 @@ int main(int argc, char** argv) {
       "stopped), 'pause' (feed hold: the tool and the mill held where they are) and 'resume'. In a safe state type\n"
       "'reset' with the handle held still near the tool to feel the part again; the mill stays\n"
       "stopped (re-homing to resume the cut is not built yet).\n"
-      "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened."};
+      "With no terminal (a service), the same come over the controller's socket (--display-socket):\n"
+      "stencil-rig status|stop|reset|pause|resume|start [--socket PATH] from its own user or root.\n"
+      "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened;\n"
+      "a control command: 0 done, 1 refused by the controller, 3 no controller."};
   app.set_version_flag("--version", report::version_text("stencil-rig"));
   app::RigOptions o;
   app::add_rig_options(app, o);
+  app::ControlOptions control;
+  app::add_control_commands(app, control);
+  app.require_subcommand(0, 1);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitBadInput);
+  }
+  if (control.chosen != nullptr) {
+    return app::run_control(control.chosen->get_name(), control);
   }
   if (o.config_keys) {
     std::printf("%s", board::sherline_suzuki::describe_rig_config_keys().c_str());
@@ -300,7 +325,7 @@ int main(int argc, char** argv) {
   job.resume_bytes = request.resume_bytes;
   job.duration_s = o.duration_s;
   app::TerminalCommands terminal;
-  wire_operator(job, o.machine_priority, terminal);
+  wire_operator(job, o.machine_priority, terminal, display.link());
   std::printf("stencil-rig: homing the mill (Ctrl-C stops it); the spindle starts only once you type 'start'\n");
   std::fflush(stdout);
   const RigResult result = board::sherline_suzuki::run_rig(

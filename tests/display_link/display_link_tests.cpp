@@ -162,6 +162,36 @@ TEST(DisplayLink, RequestsAreDecidedOnTheControllersSideAndAcceptedOnesReachTheC
   CHECK_FALSE(link.commands().pop(command));
 }
 
+// The spindle's start through the link (a service has no terminal): refused unless the program is
+// waiting for it, then taken once by the program, never as a cycle command.
+TEST(DisplayLink, AStartIsTakenOnceByTheWaitingProgramAndNeverReachesTheCycle) {
+  Prism prism;
+  Folder folder;
+  DisplayLink link(prism.part, config(), {folder.socket(), "stencil-test", false});
+  std::string error;
+  CHECK(link.start(error));
+  ControllerClient client(folder.socket());
+  poll_until(client, [&](const auto&) { return client.state() == LinkState::Connected; });
+  CHECK(client.send(make_message(MessageKind::Start, 1)));
+  std::vector<Message> answers = poll_until(client, [](const auto& a) { return !a.empty(); });
+  CHECK_EQUAL(1U, answers.size());
+  CHECK(static_cast<MessageKind>(answers[0].kind) == MessageKind::Refused);
+  STRCMP_CONTAINS("not waiting for a start", reason_of(answers[0]).c_str());
+  CHECK_FALSE(link.take_start());
+
+  link.await_start(true);
+  CHECK(client.send(make_message(MessageKind::Start, 2)));
+  CHECK(client.send(make_message(MessageKind::Start, 3)));
+  answers = poll_until(client, [](const auto& a) { return a.size() >= 2; });
+  CHECK_EQUAL(2U, answers.size());
+  CHECK(static_cast<MessageKind>(answers[0].kind) == MessageKind::Accepted);
+  CHECK(static_cast<MessageKind>(answers[1].kind) == MessageKind::Refused);  // once only
+  CHECK_TRUE(link.take_start());
+  CHECK_FALSE(link.take_start());
+  control::Command command{};
+  CHECK_FALSE(link.commands().pop(command));
+}
+
 TEST(DisplayLink, WhenTheControllerEndsTheDisplayKeepsItsLastStateAndSaysHow) {
   Prism prism;
   Folder folder;

@@ -301,6 +301,45 @@ case_killing_the_display_changes_nothing() {
   fi
 }
 
+# A service has no terminal: `stencil-rig status|pause|start|stop` reach a running controller over
+# its socket, and a stop sent so ends its job in the safe state, recorded with the display's source.
+case_control_commands_reach_a_running_controller() {
+  local socket="$PWD/control.sock" sim_pid
+  "$sim" --speed 1 --pattern raster --duration 60 --display-socket "$socket" --journal job.journal \
+    --report report.json >sim.log 2>&1 &
+  sim_pid=$!
+  for _ in $(seq 1 300); do [ -S "$socket" ] && break; sleep 0.02; done
+  # Homing first: the job runs once the cycle has made records.
+  for _ in $(seq 1 100); do
+    "$rig" status --socket "$socket" 2>/dev/null | grep -q "^job: running" && break
+    sleep 0.1
+  done
+  run_rig status --socket "$socket"
+  expect_status 0
+  grep -q "controller: stencil-sim (pid $sim_pid)" stdout.txt || fail "status does not name the controller"
+  grep -q "^job: running, cycle" stdout.txt || fail "status does not say the job runs"
+  grep -q "^safe state: none" stdout.txt || fail "status does not say there is no safe state"
+  run_rig pause --socket "$socket"
+  expect_status 0
+  sleep 0.3
+  run_rig status --socket "$socket"
+  grep -q "PAUSED" stdout.txt || fail "status does not show the pause"
+  grep -q ", held$" stdout.txt || fail "status does not show the mill held"
+  run_rig start --socket "$socket"
+  expect_status 1
+  expect_stderr "refused: not waiting for a start" "why a start is refused mid-cut"
+  run_rig stop --socket "$socket"
+  expect_status 0
+  wait "$sim_pid"
+  status=$?
+  sed 's/^/  stencil-sim: /' sim.log
+  grep -q '"safe_state": "stopped"' report.json || fail "the job did not end in the safe state 'stopped'"
+  grep -q '"source": "display"' report.json || fail "the report does not record the stop's source"
+  run_rig status --socket "$socket" --timeout 0.5
+  expect_status 3
+  expect_stderr "no controller at .*control.sock" "that no controller is there"
+}
+
 # The simulated device reached through the real PIO shared-memory and SocketCAN code: both wires
 # carry positions to the micrometre, so the two give the same report, and neither gouges.
 case_pio_and_can_give_the_same_result() {

@@ -137,9 +137,17 @@ void DisplayLink::stop() {
   }
 }
 
-std::string DisplayLink::decide(const Request& request) const {
+std::string DisplayLink::decide(const Request& request) {
   if (request.kind == RequestKind::Set) {
     return refusal(request, own_view_.header().limits);
+  }
+  if (request.kind == RequestKind::Start) {
+    bool awaiting = true;
+    if (!awaiting_start_.compare_exchange_strong(awaiting, false)) {
+      return "not waiting for a start: the spindle is started once, after homing and before the cut";
+    }
+    start_asked_.store(true);
+    return "";
   }
   Figures now{};
   const bool read = own_view_.read(now);

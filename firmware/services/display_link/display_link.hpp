@@ -4,6 +4,7 @@
 // displays (stencil-display) are processes of their own that reach it only through the socket.
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <memory>
@@ -53,12 +54,16 @@ class DisplayLink final : public control::DisplayFeed {
   [[nodiscard]] control::CommandRing& commands() override { return commands_; }
 
   [[nodiscard]] RequestCounters counters() const;
+  // The spindle's start, through the link as from the terminal: while awaited, one Start request is
+  // accepted and taken here (true once); otherwise a Start is refused.
+  void await_start(bool awaiting) { awaiting_start_.store(awaiting); }
+  [[nodiscard]] bool take_start() { return start_asked_.exchange(false); }
   [[nodiscard]] const std::string& socket_path() const { return options_.socket_path; }
   [[nodiscard]] int feed_fd() const { return feed_.fd(); }
 
  private:
   static void heard_touched(void* self, std::uint32_t id);
-  [[nodiscard]] std::string decide(const Request& request) const;
+  [[nodiscard]] std::string decide(const Request& request);
   void publish(bool now);
   void add_event(const FeedEvent& event);
 
@@ -77,6 +82,7 @@ class DisplayLink final : public control::DisplayFeed {
   FeedView own_view_;  // the reset rule reads the newest telemetry back from the feed: no lock
   control::CommandRing commands_;  // the server thread pushes, the cycle pops; outlives both
   std::unique_ptr<RequestServer> server_;
+  std::atomic<bool> awaiting_start_{false}, start_asked_{false};  // the program's and the server thread's
 };
 
 }  // namespace stencil::display_link

@@ -5,7 +5,7 @@
 //    versioned Messages both ways. A display says Hello; the controller answers Welcome with the
 //    state feed's file descriptor (SCM_RIGHTS), or Mismatch naming both versions. Then Set, Reset,
 //    Stop, Pause and Resume, each answered Accepted or Refused (with the reason) and echoing the
-//    display's id.
+//    display's id. Start (the spindle, once homed) is the confirmation the rig's terminal also takes.
 //  - The state feed: a sealed memfd the display maps read-only. A FeedHeader written once at
 //    start-up (the part's mesh, the limits), then Figures and the stock behind seqlocks, the touched
 //    set as bits that are only ever set, and each cycle's force in a ring. The controller's threads
@@ -23,7 +23,7 @@
 namespace stencil::display_link {
 
 // Any change to a Message or to the feed's layout changes this.
-inline constexpr std::uint16_t kProtocolVersion = 2;
+inline constexpr std::uint16_t kProtocolVersion = 3;
 
 // ---- the request channel ----
 
@@ -37,6 +37,8 @@ enum class MessageKind : std::uint8_t {
   Stop = 4,      // display -> controller: never rate-limited
   Pause = 5,     // display -> controller: feed hold
   Resume = 6,    // display -> controller
+  Start = 7,     // display or `stencil-rig start` -> controller: the spindle on, once homed (the
+                 // terminal's 'start'); refused unless the program is waiting for it
   Welcome = 16,  // controller -> display, with the feed's descriptor
   Accepted = 17,
   Refused = 18,  // reason: why

@@ -14,6 +14,7 @@ bool known_kind(std::uint8_t kind) {
     case MessageKind::Stop:
     case MessageKind::Pause:
     case MessageKind::Resume:
+    case MessageKind::Start:
     case MessageKind::Welcome:
     case MessageKind::Accepted:
     case MessageKind::Refused:
@@ -85,7 +86,7 @@ DecodeResult decode_request(const unsigned char* bytes, std::size_t size, Messag
   const auto kind = static_cast<MessageKind>(message.kind);
   if (static_cast<std::uint8_t>(kind) >= static_cast<std::uint8_t>(MessageKind::Welcome)) {
     error = at(offsetof(Message, kind),
-               "kind " + std::to_string(message.kind) + " is an answer: a display sends Hello, Set, Reset, Stop, Pause or Resume");
+               "kind " + std::to_string(message.kind) + " is an answer: a display sends Hello, Set, Reset, Stop, Pause, Resume or Start");
     return DecodeResult::Malformed;
   }
   return DecodeResult::Ok;
@@ -123,6 +124,8 @@ Request request_of(const Message& message) {
       return Request{RequestKind::Pause, Parameter::Coupling, 0.0};
     case MessageKind::Resume:
       return Request{RequestKind::Resume, Parameter::Coupling, 0.0};
+    case MessageKind::Start:
+      return Request{RequestKind::Start, Parameter::Coupling, 0.0};
     default:
       return Request{RequestKind::Reset, Parameter::Coupling, 0.0};
   }

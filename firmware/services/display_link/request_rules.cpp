@@ -53,8 +53,10 @@ control::Command command_of(const Request& request) {
       return {control::CommandKind::Pause, 0.0, kDisplay};
     case RequestKind::Resume:
       return {control::CommandKind::Resume, 0.0, kDisplay};
+    case RequestKind::Start:
+      break;  // never a cycle command (the request server takes it to the waiting program)
   }
-  return {control::CommandKind::Stop, 0.0, kDisplay};  // unreachable: a stop is the safe guess
+  return {control::CommandKind::Stop, 0.0, kDisplay};  // not a command: a stop is the safe guess
 }
 
 std::string refusal(const Request& request, const RequestLimits& limits) {

@@ -10,7 +10,8 @@
 
 namespace stencil::display_link {
 
-enum class RequestKind : std::uint8_t { Set, Reset, Stop, Pause, Resume };
+// Start is not a cycle command: it answers the program waiting to turn the spindle on (never the ring).
+enum class RequestKind : std::uint8_t { Set, Reset, Stop, Pause, Resume, Start };
 enum class Parameter : std::uint8_t { Coupling, ForceLimit, SpeedLimit };
 inline constexpr int kParameterCount = 3;
 

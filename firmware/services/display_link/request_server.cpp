@@ -250,7 +250,9 @@ void RequestServer::handle(Peer& peer, const Message& message) {
     // The last slot is kept for a stop; a stop pressed again within 100 ms of one already sent is the
     // same stop (accepted, not sent twice), so a held-down key fills neither the ring nor the record.
     const bool stop = request.kind == RequestKind::Stop;
-    if (refusal.empty() && stop && now - last_stop_s_ < 0.1) {
+    if (refusal.empty() && request.kind == RequestKind::Start) {
+      // Taken by decide() itself (the program waiting to start the spindle): nothing for the cycle.
+    } else if (refusal.empty() && stop && now - last_stop_s_ < 0.1) {
       ++stops_merged_;
     } else if (refusal.empty()) {
       const bool room = stop ? commands_.size() < control::CommandRing::capacity()

@@ -22,6 +22,8 @@ const char* request_name(RequestKind kind) {
       return "pause";
     case RequestKind::Resume:
       return "resume";
+    case RequestKind::Start:
+      return "start";
   }
   return "unknown";
 }
@@ -38,6 +40,8 @@ display_link::Message message_of(const Request& request, std::uint32_t id) {
       return display_link::make_message(display_link::MessageKind::Pause, id);
     case RequestKind::Resume:
       return display_link::make_message(display_link::MessageKind::Resume, id);
+    case RequestKind::Start:
+      return display_link::make_message(display_link::MessageKind::Start, id);
   }
   return display_link::make_message(display_link::MessageKind::Stop, id);
 }
