@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour fresh-check clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour fresh-check package package-check clean help
 
 all: build
 
@@ -18,6 +18,8 @@ help:
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
 	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
+	@echo "make package    the Debian package (CPack): build/stencil_<version>_<arch>.deb"
+	@echo "make package-check install, use and purge that package in a clean Debian 12 root (mmdebstrap; needs root; a few minutes)"
 	@echo "make fresh-check README's two commands in a clean Debian 12 root (mmdebstrap; needs root; about half an hour)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
@@ -109,6 +111,17 @@ same-behaviour:
 # A check, not a test: README's two commands in a clean Debian 12 root made with mmdebstrap, the
 # committed HEAD cloned into it (toolchain/fresh-check.sh; needs root). Run it after any change to
 # the dependencies, the lock file or install-deps.sh.
+# The Debian package of the programs, the page, the sample parts and the services (CPack's DEB
+# generator; toolchain/cmake/stencil-package.cmake).
+package: build
+	cmake --build --preset release --target package
+
+# The package in a clean Debian 12 root: installed, used and purged (toolchain/package-check.sh;
+# ctest label `package`; needs root and Debian's archive). Not part of make test or CI.
+package-check: package
+	@bash toolchain/install-deps.sh --fresh-check
+	ctest --preset package
+
 fresh-check:
 	@bash toolchain/install-deps.sh --fresh-check
 	bash toolchain/fresh-check.sh build/fresh-check

@@ -47,6 +47,8 @@ packages=(
   libboost-dev       # stencil-display's HTTP and WebSocket server: Boost.Beast (header-only)
   chromium           # the display's end-to-end test, headless (driven by playwright-core from npm)
   fonts-dejavu-core  # text in that browser's screenshots
+  help2man           # make package: man pages from the programs' --help
+  dpkg-dev           # make package: dpkg-shlibdeps finds the package's runtime dependencies
 )
 # The display's page is built with npm (three.js and esbuild, pinned by its package-lock.json): the
 # machine's own Node.js and npm when it has them, else Debian's (Node 18 on Debian 12: every package

@@ -6,7 +6,8 @@
 
 namespace stencil::board::sherline_suzuki {
 
-bool write_rig_report(const std::string& path, const RigResult& r, const std::string& machine_error, std::string& error) {
+bool write_rig_report(const std::string& path, const RigResult& r, const std::string& machine_error,
+                      const report::Provenance& provenance, std::string& error) {
   report::JobFigures f;
   f.cycles = r.cycles;
   f.overruns = r.overruns;
@@ -24,6 +25,7 @@ bool write_rig_report(const std::string& path, const RigResult& r, const std::st
   f.earlier = r.earlier;
   f.operator_record = r.operator_record;
   f.touched_rebuilt = r.touched_rebuilt;
+  f.provenance = provenance;
   const nlohmann::json rig_sections = {
       {"first_fault", r.first_fault == control::SafeReason::None ? nlohmann::json(nullptr)
                                                                  : nlohmann::json(control::safe_reason_name(r.first_fault))},

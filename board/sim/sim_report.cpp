@@ -101,8 +101,11 @@ bool write_stock_csv(const std::string& path, const SimResult& r, std::string& e
   return true;
 }
 
-bool write_report_json(const std::string& path, const SimResult& r, std::string& error) {
-  return report::write_job_report(path, figures_of(r), simulation_sections(r), error);
+bool write_report_json(const std::string& path, const SimResult& r, const report::Provenance& provenance,
+                       std::string& error) {
+  report::JobFigures figures = figures_of(r);
+  figures.provenance = provenance;
+  return report::write_job_report(path, figures, simulation_sections(r), error);
 }
 
 std::string summary(const SimResult& r) {

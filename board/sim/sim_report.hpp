@@ -5,11 +5,13 @@
 #include <string>
 
 #include "board/sim/sim_job.hpp"
+#include "firmware/services/report/provenance.hpp"
 
 namespace stencil::board::sim {
 
 // Writes the report as JSON; false with `error` naming the path on failure.
-[[nodiscard]] bool write_report_json(const std::string& path, const SimResult& result, std::string& error);
+[[nodiscard]] bool write_report_json(const std::string& path, const SimResult& result,
+                                     const report::Provenance& provenance, std::string& error);
 
 // The machined stock's heights as CSV, one Z-map row per line (y rising), mm.
 [[nodiscard]] bool write_stock_csv(const std::string& path, const SimResult& result, std::string& error);

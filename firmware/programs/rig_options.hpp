@@ -10,11 +10,13 @@
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/core/control/commanded_stock.hpp"
 #include "firmware/programs/display_option.hpp"
+#include "firmware/services/report/provenance.hpp"
 
 namespace stencil::app {
 
 struct RigOptions {
   std::string config_path;    // --config: the rig's file (empty: the compiled-in Sherline/Suzuki rig)
+  report::Provenance provenance;  // filled in once the tables are loaded: the report's and the journal's
   bool config_keys = false;   // --config-keys: print every key of the file and exit
   bool commission = false;    // --commission: commission the mill against a dial indicator instead of a job
   board::sherline_suzuki::RigConfig config;  // the file's (or the defaults), with the command line's overrides

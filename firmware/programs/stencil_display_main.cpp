@@ -13,6 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "firmware/services/report/build_version.hpp"
+#include "firmware/programs/installed_files.hpp"
 #include "firmware/services/hmi/display_app.hpp"
 
 namespace {
@@ -44,7 +45,7 @@ int main(int argc, char** argv) {
                  "a file only its owner may read, holding the token on its first line (needed beyond loopback; "
                  "for a service: systemd's LoadCredential=). Only a browser that opens the page with ?token=T "
                  "may change parameters or reset; the others watch");
-  app.add_option("--assets", assets, "the built page's folder (default: ../hmi beside this program)");
+  app.add_option("--assets", assets, "the built page's folder (default: share/stencil/page beside an installed program, else the build's hmi/)");
   app.add_option("--max-clients", max_clients, "browsers watching at once")->check(CLI::Range(1, 256))->capture_default_str();
   app.add_option("--max-connections", max_connections, "sockets open at once; more are closed at once")
       ->check(CLI::Range(2, 1024))
@@ -71,9 +72,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   if (assets.empty()) {
-    std::error_code ec;
-    const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
-    assets = (self.parent_path().parent_path() / "hmi").string();
+    assets = app::page_folder();
   }
   options.web.assets_dir = assets;
   options.web.max_clients = max_clients;

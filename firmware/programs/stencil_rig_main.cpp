@@ -77,6 +77,7 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
   request.start.tables_crc32 = part.header.crc32;
   request.start.triangle_count = part.header.triangle_count;
   request.start.job = job_text_of(job.offset, job.stock, o.config.file_crc32);
+  request.provenance = report::provenance_line(o.provenance);
   if (!o.resume_path.empty()) {
     journal::JobHistory history;
     if (!journal::read_job_history(o.resume_path, part.header.crc32, part.header.triangle_count,
@@ -184,7 +185,7 @@ int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::
   if (!result.machine_stall.empty()) {
     std::fprintf(stderr, "stencil-rig: %s\n", result.machine_stall.c_str());
   }
-  if (!o.report_path.empty() && !board::sherline_suzuki::write_rig_report(o.report_path, result, machine_error, error)) {
+  if (!o.report_path.empty() && !board::sherline_suzuki::write_rig_report(o.report_path, result, machine_error, o.provenance, error)) {
     return fail(kExitBadInput, error);
   }
   const bool asked = result.safe_state == control::SafeReason::Stopped && result.first_fault == control::SafeReason::None &&
@@ -266,6 +267,13 @@ int main(int argc, char** argv) {
     return fail(kExitBadInput, error);
   }
   job.facts = o.config.facts;
+  o.provenance.program = "stencil-rig";
+  o.provenance.command_line.assign(argv, argv + argc);
+  o.provenance.configuration = o.config_path;
+  o.provenance.configuration_crc32 = o.config.file_crc32;
+  o.provenance.tables = o.tables_path;
+  o.provenance.tables_crc32 = part.header.crc32;
+  o.provenance.triangle_count = part.header.triangle_count;
   const board::sherline_suzuki::TableFitJob fit{
       {job.offset.home_world_mm.x(), job.offset.home_world_mm.y(), job.offset.home_world_mm.z()},
       job.offset.tool_stick_out_mm, job.offset.reference_stick_out_mm};

@@ -139,7 +139,7 @@ std::size_t commands_differing_from(const std::vector<control::CommandEvent>& re
 
 // --replay: every run the journal holds, in turn, each from the state the runs before it left.
 int replay(const std::string& path, const tables::PartTables& part, board::sim::SimJob job, const std::string& report_path,
-           const std::string& stock_csv_path, double pace) {
+           const std::string& stock_csv_path, double pace, const report::Provenance& provenance) {
   journal::JobHistory history;
   std::string error;
   if (!journal::read_job_history(path, part.header.crc32, part.header.triangle_count, board::sim::frames(job.rig), {}, history,
@@ -192,7 +192,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
   }
   std::printf("%s", board::sim::summary(result).c_str());
   const std::string picture_path = picture_path_of(report_path);
-  if (!board::sim::write_report_json(report_path, result, error) || !board::sim::write_picture_svg(picture_path, result, error) ||
+  if (!board::sim::write_report_json(report_path, result, provenance, error) || !board::sim::write_picture_svg(picture_path, result, error) ||
       (!stock_csv_path.empty() && !board::sim::write_stock_csv(stock_csv_path, result, error))) {
     return bad_input(error);
   }
@@ -410,7 +410,7 @@ board::sim::SimResult run(const app::SimOptions& o, board::sim::SimJob& job) {
 // After the run: the journal ended in order (or, when nothing ran, every output of this run undone),
 // the summary, the report, the picture and the stock's heights. The program's exit status.
 int finish(const app::SimOptions& o, board::sim::SimResult& result, const journal::JobJournalRequest& request,
-           journal::JournalWriter& journal_writer, const std::string& journal_path) {
+           journal::JournalWriter& journal_writer, const std::string& journal_path, const report::Provenance& provenance) {
   std::string error;
   if (!result.started) {
     if (!journal::undo_unrun_job_journal(request, journal_writer, journal_path)) {
@@ -434,7 +434,7 @@ int finish(const app::SimOptions& o, board::sim::SimResult& result, const journa
   }
   std::printf("%s", board::sim::summary(result).c_str());
   const std::string picture_path = picture_path_of(o.report_path);
-  if (!board::sim::write_report_json(o.report_path, result, error) ||
+  if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
       !board::sim::write_picture_svg(picture_path, result, error) ||
       (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
     return bad_input(error);
@@ -483,8 +483,16 @@ int main(int argc, char** argv) {
   if (o.commission) {
     return commission(o, job);
   }
+  report::Provenance provenance;
+  provenance.program = "stencil-sim";
+  provenance.command_line.assign(argv, argv + argc);
+  provenance.configuration = o.config_path;
+  provenance.configuration_crc32 = o.config_crc32;
+  provenance.tables = o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path;
+  provenance.tables_crc32 = part.header.crc32;
+  provenance.triangle_count = part.header.triangle_count;
   if (!o.replay_path.empty()) {
-    return replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed);
+    return replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed, provenance);
   }
   journal::JobJournalRequest request;
   request.program = "stencil-sim";
@@ -495,6 +503,7 @@ int main(int argc, char** argv) {
   request.start.tables_crc32 = part.header.crc32;
   request.start.triangle_count = part.header.triangle_count;
   request.start.job = job_text;
+  request.provenance = report::provenance_line(provenance);
   if (!o.resume_path.empty() && !prepare_resume(o, part, job_text, job, request, error)) {
     return bad_input(error);
   }
@@ -543,5 +552,5 @@ int main(int argc, char** argv) {
                    : std::string(", in the safe state (") + control::safe_reason_name(result.safe_state) + ")"));
   display.stop();
   files.close();
-  return finish(o, result, request, journal_writer, journal_path);
+  return finish(o, result, request, journal_writer, journal_path, provenance);
 }

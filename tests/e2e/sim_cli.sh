@@ -56,20 +56,31 @@ at_most() {
 }
 
 # journal_size_ok JOURNAL REPORT EVENTS WHAT: the journal is exactly the file header, its start
-# record, a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command, a
+# record and the provenance record after it (type 9), a 115-byte record per cycle, the 17-byte homing, a 64-byte record per machine command, a
 # 52-byte record per command the cycle took, a 19-byte record per safe-state event (EVENTS), as the
 # report counts them, and the 18-byte end.
 journal_size_ok() {
-  local journal=$1 report=$2 events=$3 what=$4 start cycles commands taken size expected
+  local journal=$1 report=$2 events=$3 what=$4 start provenance cycles commands taken size expected
   start=$(od -An -tu4 -j12 -N4 "$journal" | tr -d ' ')
+  provenance=$(od -An -tu4 -j$((12 + 9 + start)) -N4 "$journal" | tr -d ' ')
+  [ "$(od -An -tu1 -j$((12 + 9 + start + 4)) -N1 "$journal" | tr -d ' ')" = 9 ] ||
+    fail "$what: no provenance record after the start record"
   cycles=$(json_number "$report" cycles)
   commands=$(json_number "$report" machine_records)
   taken=$(json_number "$report" command_records)
   size=$(stat -c %s "$journal")
-  expected=$((12 + 9 + start + 115 * cycles + 17 + 64 * commands + 52 * taken + 19 * events + 18))
+  expected=$((12 + 9 + start + 9 + provenance + 115 * cycles + 17 + 64 * commands + 52 * taken + 19 * events + 18))
   [ "$size" -eq "$expected" ] ||
     fail "$what: $journal is $size bytes; expected $expected ($cycles cycles, $commands machine commands, $taken commands taken, $events safe-state events)"
   [ "$commands" -gt 0 ] || fail "$what: no machine command in the journal"
+}
+
+# strip_wall_clock REPORT: the report without what differs between two runs of the same job: the
+# wall clock's figures and the provenance (the command line, which names each run's own outputs).
+strip_wall_clock() {
+  awk '/"provenance": \{/ { prov = 1; depth = 0 }
+    prov { depth += gsub(/[{[]/, "&"); depth -= gsub(/[]}]/, "&"); if (depth <= 0) prov = 0; next }
+    /"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
 }
 
 # stock_within CSV REFERENCE LIMIT WHAT: every cell of the two stocks within LIMIT mm.
@@ -253,9 +264,6 @@ case_script_csv_that_cannot_be_written_is_refused() {
 
 # The same inputs give the same report, apart from the wall-clock fields.
 case_same_report_twice() {
-  strip_wall_clock() {
-    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
-  }
   run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report first.json
   expect_status 0
   run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report second.json
@@ -268,9 +276,6 @@ case_same_report_twice() {
 # A display killed part way through a job changes nothing in it: the controller neither waits for
 # nor depends on its displays, so the report is the same as without one (apart from wall clock).
 case_killing_the_display_changes_nothing() {
-  strip_wall_clock() {
-    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
-  }
   local display socket display_pid sim_pid
   display="$(dirname "$sim")/stencil-display"
   socket="$PWD/display.sock"
@@ -343,9 +348,6 @@ case_control_commands_reach_a_running_controller() {
 # The simulated device reached through the real PIO shared-memory and SocketCAN code: both wires
 # carry positions to the micrometre, so the two give the same report, and neither gouges.
 case_pio_and_can_give_the_same_result() {
-  strip_wall_clock() {
-    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
-  }
   run_sim --fast --pattern plunge --duration 90 --haptic-transport pio --no-journal --report pio.json
   expect_status 0
   cp pio.json report.json && no_gouge
@@ -383,9 +385,6 @@ case_refuses_to_run_without_a_clock() {
 # --speed N (N other than 1) is the virtual clock held to N x the wall clock: the same report as
 # --fast, timing aside, and no faster than N allows.
 case_speed_n_is_fast_mode_paced() {
-  strip_wall_clock() {
-    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
-  }
   run_sim --fast --pattern plunge --duration 12 --no-journal --report fast.json
   expect_status 0
   run_sim --speed 20 --pattern plunge --duration 12 --no-journal --report paced.json
@@ -796,9 +795,6 @@ case_rig_refuses_a_bad_configuration() {
 # The shipped example configuration is the compiled-in rig: the same job gives the same report with
 # it as without it (wall-clock fields aside). make demo's whole job is compared by hand (README).
 case_example_configuration_gives_the_same_report() {
-  strip_wall_clock() {
-    awk '/"(compute_us|memory_kb)": \{/ { skip = 1 } skip && /\}/ { skip = 0; next } !skip && !/"wall_s":/' "$1"
-  }
   install -m 600 "$repo/board/sherline_suzuki/rig.toml" rig.toml
   run_sim --fast --pattern random --seed 3 --duration 60 --no-journal --report defaults.json
   expect_status 0

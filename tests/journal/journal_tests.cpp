@@ -98,6 +98,7 @@ struct Seen {
   JournalStart start;
   std::vector<stencil::control::CommandSource> sources;  // each safe state's
   std::vector<stencil::control::CommandEvent> taken;     // the cycle's commands
+  std::vector<std::string> provenances;
   JournalVisitor visitor() {
     JournalVisitor v;
     v.start = [this](const JournalStart& s) {
@@ -112,6 +113,7 @@ struct Seen {
     v.machine_command = [this](const stencil::control::MachineCommandRecord& c) { commands.push_back(c); };
     v.resume = [this](const JournalResume& r) { resumes.push_back(r); };
     v.end = [this](std::uint64_t c, SafeReason reason) { endings.emplace_back(c, reason); };
+    v.provenance = [this](const std::string& text) { provenances.push_back(text); };
     return v;
   }
 };
@@ -262,7 +264,7 @@ TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
   bytes[8] = 9;
   read = read_journal(bytes.data(), bytes.size(), seen.visitor());
   CHECK_FALSE(read.ok);
-  STRCMP_CONTAINS("journal offset 8: version 9; this program reads versions 2 to 3", read.error.c_str());
+  STRCMP_CONTAINS("journal offset 8: version 9; this program reads versions 2 to 4", read.error.c_str());
   read = read_journal_file("/nonexistent/journal", seen.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());
@@ -515,7 +517,78 @@ TEST(Journal, AVersion2JournalStillReadsButIsNotCarriedOn) {
   JournalResume resume;
   resume.segment = 1;
   CHECK_FALSE(writer.open_to_resume(file.path, read.good_bytes, resume));
-  STRCMP_CONTAINS("is a version 2 journal; this program carries on version 3 journals only", writer.error().c_str());
+  STRCMP_CONTAINS("is a version 2 journal; this program carries on versions 3 and 4 only", writer.error().c_str());
+}
+
+// Which build made each run, after its Start and each Resume; a version 3 journal (none) is carried on
+// without them, so it stays a version 3 journal.
+TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnWithoutIt) {
+  TempJournal file;
+  {
+    JournalWriter writer;
+    JournalStart start = start_of();
+    start.provenance = "journal_tests v1 (GNU 12); configuration compiled-in; command: journal_tests";
+    CHECK_TRUE(writer.open(file.path, start));
+    CHECK_TRUE(writer.append(record_of(0)));
+    CHECK_TRUE(writer.close());
+  }
+  Seen first;
+  JournalReadResult read = read_journal_file(file.path, first.visitor());
+  CHECK_TEXT(read.ok, read.error.c_str());
+  CHECK_EQUAL(1U, first.provenances.size());
+  STRCMP_EQUAL("journal_tests v1 (GNU 12); configuration compiled-in; command: journal_tests", first.provenances[0].c_str());
+  {
+    JournalWriter writer;
+    JournalResume resume;
+    resume.segment = 1;
+    resume.program = "journal_tests";
+    resume.provenance = "journal_tests v2; command: journal_tests --resume";
+    CHECK_TRUE(writer.open_to_resume(file.path, read.good_bytes, resume));
+    CHECK_TRUE(writer.close());
+  }
+  Seen both;
+  read = read_journal_file(file.path, both.visitor());
+  CHECK_TEXT(read.ok, read.error.c_str());
+  CHECK_EQUAL(2U, both.provenances.size());
+  STRCMP_EQUAL("journal_tests v2; command: journal_tests --resume", both.provenances[1].c_str());
+
+  // A version 3 journal: the same records without Provenance, carried on without one.
+  write_job(file.path, 3);
+  std::vector<std::uint8_t> bytes = file.bytes();
+  bytes[8] = 3;
+  {
+    std::ofstream out(file.path, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  }
+  {
+    JournalWriter writer;
+    JournalResume resume;
+    resume.segment = 1;
+    resume.provenance = "journal_tests v2";
+    CHECK_TRUE(writer.open_to_resume(file.path, bytes.size(), resume));
+    CHECK_TRUE(writer.close());
+  }
+  Seen old;
+  read = read_journal_file(file.path, old.visitor());
+  CHECK_TEXT(read.ok, read.error.c_str());
+  CHECK_EQUAL(1U, old.resumes.size());
+  CHECK_EQUAL(0U, old.provenances.size());
+  CHECK_EQUAL(3U, file.bytes()[8]);
+
+  // A provenance record in a version 3 journal is damage, named by its offset.
+  {
+    JournalWriter writer;
+    JournalStart start = start_of();
+    start.provenance = "x";
+    CHECK_TRUE(writer.open(file.path, start));
+    CHECK_TRUE(writer.close());
+  }
+  bytes = file.bytes();
+  bytes[8] = 3;
+  Seen damaged;
+  read = read_journal(bytes.data(), bytes.size(), damaged.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("a provenance record of 3 bytes in a version 3 journal", read.error.c_str());
 }
 
 TEST(Journal, ACommandRecordOutOfRangeIsAnErrorNamingTheOffset) {

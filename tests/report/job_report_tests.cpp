@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "board/sherline_suzuki/rig_report.hpp"
+#include "firmware/services/report/build_version.hpp"
 #include "firmware/services/report/job_report.hpp"
 
 // Last: its memory-leak macros redefine new.
@@ -66,8 +67,16 @@ TEST(JobReport, TheRigsReportHasTheFiguresAndItsFaultsAndResets) {
   result.wakeup_latency_us = {10.0, 20.0, 30.0, 40.0};
   result.earlier.segments = 1;
   result.earlier.cycles = 700;
+  report::Provenance provenance;
+  provenance.program = "stencil-rig";
+  provenance.command_line = {"stencil-rig", "--config", "/etc/stencil/rig.toml", "--tables", "my part.stbl"};
+  provenance.configuration = "/etc/stencil/rig.toml";
+  provenance.configuration_crc32 = 0x1a2b3c4dU;
+  provenance.tables = "my part.stbl";
+  provenance.tables_crc32 = 0xdeadbeefU;
+  provenance.triangle_count = 24;
   std::string error;
-  CHECK_TRUE(board::sherline_suzuki::write_rig_report(path, result, "no reply to '? B'", error));
+  CHECK_TRUE(board::sherline_suzuki::write_rig_report(path, result, "no reply to '? B'", provenance, error));
   const nlohmann::json written = read_back(path);
   STRCMP_EQUAL("device_fault", written["first_fault"].get<std::string>().c_str());
   STRCMP_EQUAL("stopped", written["safe_state"].get<std::string>().c_str());
@@ -77,4 +86,34 @@ TEST(JobReport, TheRigsReportHasTheFiguresAndItsFaultsAndResets) {
   CHECK_EQUAL(2, written["job"]["runs"].get<int>());
   CHECK_EQUAL(5700, written["job"]["total_cycles"].get<int>());
   STRCMP_EQUAL("no reply to '? B'", written["machine"]["error"].get<std::string>().c_str());
+  // What made it: the build, the command line, the configuration's digest and the tables' identity.
+  const nlohmann::json& made = written["provenance"];
+  STRCMP_EQUAL("stencil-rig", made["program"].get<std::string>().c_str());
+  STRCMP_EQUAL(report::source_version(), made["version"].get<std::string>().c_str());
+  STRCMP_EQUAL(report::build_compiler(), made["compiler"].get<std::string>().c_str());
+  STRCMP_EQUAL("my part.stbl", made["command_line"][4].get<std::string>().c_str());
+  STRCMP_EQUAL("1a2b3c4d", made["configuration"]["crc32"].get<std::string>().c_str());
+  STRCMP_EQUAL("/etc/stencil/rig.toml", made["configuration"]["path"].get<std::string>().c_str());
+  STRCMP_EQUAL("deadbeef", made["tables"]["crc32"].get<std::string>().c_str());
+  CHECK_EQUAL(24, made["tables"]["triangles"].get<int>());
+}
+
+TEST(JobReport, ProvenanceAsOneLineForTheJournalQuotesWhatAShellWouldSplit) {
+  report::Provenance p;
+  p.program = "stencil-sim";
+  p.command_line = {"stencil-sim", "--fast", "--operator", "it's here.csv"};
+  p.tables = "(baked-in hex prism)";
+  p.tables_crc32 = 0x00c0ffeeU;
+  p.triangle_count = 24;
+  const std::string line = report::provenance_line(p);
+  STRCMP_CONTAINS((std::string("stencil-sim ") + report::source_version() + " (").c_str(), line.c_str());
+  STRCMP_CONTAINS("; configuration compiled-in;", line.c_str());
+  STRCMP_CONTAINS("tables (baked-in hex prism) crc32=00c0ffee triangles=24;", line.c_str());
+  STRCMP_CONTAINS("command: stencil-sim --fast --operator 'it'\\''s here.csv'", line.c_str());
+  STRCMP_EQUAL("compiled-in", report::provenance_json(p)["configuration"].get<std::string>().c_str());
+  // A command line too long for a record is cut, and says so.
+  p.command_line.assign(2000, "--seed=12345");
+  const std::string cut = report::provenance_line(p);
+  CHECK_EQUAL(4000U, cut.size());
+  STRCMP_CONTAINS("...", cut.substr(3990).c_str());
 }

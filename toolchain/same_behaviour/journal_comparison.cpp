@@ -35,7 +35,9 @@ struct Record {
 
 struct Journal {
   std::vector<std::uint8_t> bytes;
-  std::vector<Record> records;
+  std::vector<Record> records;  // every whole record but the Provenance ones (the build's, not the job's)
+  std::uint64_t provenance = 0;
+  std::uint32_t version = 0;
   std::size_t good_bytes = 0;  // the rest is a torn tail, compared as plain bytes
 };
 
@@ -49,6 +51,7 @@ const char* type_name(RecordType type) {
     case RecordType::Resume: return "resume";
     case RecordType::End: return "end";
     case RecordType::Command: return "command";
+    case RecordType::Provenance: return "provenance";
   }
   return "unknown";
 }
@@ -76,12 +79,18 @@ std::string load(const std::string& path, Journal& journal) {
     return path + ": " + result.error;
   }
   journal.good_bytes = result.good_bytes;
+  journal::ByteReader version(journal.bytes.data() + sizeof journal::kMagic, 4);
+  journal.version = version.u32();
   for (const std::size_t offset : offsets) {
     journal::ByteReader head(journal.bytes.data() + offset, journal.bytes.size() - offset);
     Record record;
     record.offset = offset;
     record.length = head.u32();
     record.type = static_cast<RecordType>(head.u8());
+    if (record.type == RecordType::Provenance) {
+      ++journal.provenance;
+      continue;
+    }
     if (record.type == RecordType::Start || record.type == RecordType::Resume) {
       const std::size_t payload = offset + kRecordHeadBytes;
       record.masked_from = payload + (record.type == RecordType::Start ? kStartTimeInStart : kStartTimeInResume);
@@ -98,17 +107,20 @@ std::string load(const std::string& path, Journal& journal) {
   return "";
 }
 
-// The first byte in [from, to) where the two files differ, leaving out the record's start time; `to` if none.
-std::size_t first_difference(const Journal& a, const Journal& b, std::size_t from, std::size_t to, const Record& record) {
-  for (std::size_t i = from; i < to; ++i) {
-    if (i >= record.masked_from && i < record.masked_to) {
+// The first byte of record `ra` (its first `count` bytes) where it differs from `rb`, leaving out the
+// record's start time, as a file offset in `a`; `ra.offset + count` if none. The two may sit at
+// different offsets (one journal has Provenance records the other has not).
+std::size_t first_difference(const Journal& a, const Journal& b, const Record& ra, const Record& rb, std::size_t count) {
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t i = ra.offset + k;
+    if (i >= ra.masked_from && i < ra.masked_to) {
       continue;
     }
-    if (a.bytes[i] != b.bytes[i]) {
+    if (a.bytes[i] != b.bytes[rb.offset + k]) {
       return i;
     }
   }
-  return to;
+  return ra.offset + count;
 }
 
 std::string describe(const Journal& journal, std::size_t index, const Record& record) {
@@ -132,6 +144,15 @@ std::string part_at(const Record& record, std::size_t at) {
   return "its CRC-32";
 }
 
+// The file header and every compared record: the whole records' bytes but the Provenance ones.
+std::size_t records_bytes(const Journal& journal) {
+  std::size_t bytes = journal::kFileHeaderBytes;
+  for (const Record& record : journal.records) {
+    bytes += journal::kRecordOverheadBytes + record.length;
+  }
+  return bytes;
+}
+
 }  // namespace
 
 JournalComparison compare_journals(const std::string& older_path, const std::string& newer_path) {
@@ -146,16 +167,21 @@ JournalComparison compare_journals(const std::string& older_path, const std::str
     return out;
   }
   out.records = older.records.size();
-  // The reader accepted both headers (the magic and its one version), so they are equal; compared all the same.
-  if (!std::equal(older.bytes.begin(), older.bytes.begin() + journal::kFileHeaderBytes, newer.bytes.begin())) {
-    out.differences.push_back("the file headers (magic, version) differ");
+  // The reader accepted both headers. Versions 3 and 4 differ only in 4's Provenance records, which
+  // say which build wrote the file and are left out; any other difference of versions is one.
+  const bool provenance_step = std::min(older.version, newer.version) + 1 == journal::kProvenanceVersion &&
+                               std::max(older.version, newer.version) == journal::kProvenanceVersion;
+  if (older.version != newer.version && !provenance_step) {
+    out.differences.push_back("the file versions differ: " + std::to_string(older.version) + " and " +
+                              std::to_string(newer.version));
   }
+  out.provenance = older.provenance + newer.provenance;
   std::size_t differing = 0;
   const std::size_t common = std::min(older.records.size(), newer.records.size());
   for (std::size_t i = 0; i < common; ++i) {
     const Record& a = older.records[i];
     const Record& b = newer.records[i];
-    if (a.offset != b.offset || a.length != b.length || a.type != b.type) {
+    if (a.length != b.length || a.type != b.type) {
       out.differences.push_back(describe(older, i, a) + " in the older, " + describe(newer, i, b) + " in the newer (" +
                                 std::to_string(a.length) + " and " + std::to_string(b.length) +
                                 " payload bytes); the records after it are not compared");
@@ -166,8 +192,9 @@ JournalComparison compare_journals(const std::string& older_path, const std::str
     }
     // The whole record, length to CRC; a Start or Resume record's CRC covers its time, so it is left out too.
     const bool timed = a.masked_to > a.masked_from;
-    const std::size_t end = a.offset + journal::kRecordOverheadBytes + a.length - (timed ? kCrcBytes : 0);
-    const std::size_t at = first_difference(older, newer, a.offset, end, a);
+    const std::size_t count = journal::kRecordOverheadBytes + a.length - (timed ? kCrcBytes : 0);
+    const std::size_t end = a.offset + count;
+    const std::size_t at = first_difference(older, newer, a, b, count);
     if (at != end && ++differing <= kMostDifferencesShown) {
       out.differences.push_back(describe(older, i, a) + ": " + part_at(a, at) + " differs");
     }
@@ -187,7 +214,9 @@ JournalComparison compare_journals(const std::string& older_path, const std::str
     out.differences.push_back("the torn tails differ: " + std::to_string(older.bytes.size() - older.good_bytes) + " and " +
                               std::to_string(newer.bytes.size() - newer.good_bytes) + " bytes after the last whole record");
   }
-  if (older.bytes.size() != newer.bytes.size()) {
+  const std::size_t provenance_bytes_older = older.good_bytes - records_bytes(older);
+  const std::size_t provenance_bytes_newer = newer.good_bytes - records_bytes(newer);
+  if (older.bytes.size() - provenance_bytes_older != newer.bytes.size() - provenance_bytes_newer) {
     out.differences.push_back(std::to_string(older.bytes.size()) + " bytes in the older, " + std::to_string(newer.bytes.size()) +
                               " in the newer");
   }

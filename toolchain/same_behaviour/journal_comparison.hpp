@@ -13,10 +13,12 @@ struct JournalComparison {
   std::vector<std::string> differences;  // the first few records that differ, and how; any fails
   std::uint64_t records = 0;             // whole records in the older journal
   std::uint64_t start_times = 0;         // Start and Resume records whose time was left out
+  std::uint64_t provenance = 0;          // Provenance records left out (both journals')
 };
 
 // Reads both with the project's journal reader (every record's length, type and CRC checked), then
-// compares every byte except, in each Start and Resume record, its i64 start time and its CRC-32.
+// compares every byte except, in each Start and Resume record, its i64 start time and its CRC-32, and
+// the Provenance records (which build wrote it, with what command line: not the job's behaviour).
 [[nodiscard]] JournalComparison compare_journals(const std::string& older_path, const std::string& newer_path);
 
 }  // namespace stencil::same_behaviour

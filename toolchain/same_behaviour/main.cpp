@@ -64,8 +64,9 @@ int journals(const std::string& older_path, const std::string& newer_path) {
     std::printf("differs: %s\n", line.c_str());
   }
   if (result.differences.empty()) {
-    std::printf("same (%llu records; the start time of %llu start/resume record(s) left out)\n",
-                static_cast<unsigned long long>(result.records), static_cast<unsigned long long>(result.start_times));
+    std::printf("same (%llu records; the start time of %llu start/resume record(s) and %llu provenance record(s) left out)\n",
+                static_cast<unsigned long long>(result.records), static_cast<unsigned long long>(result.start_times),
+                static_cast<unsigned long long>(result.provenance));
   }
   return result.differences.empty() ? kSame : kDifferent;
 }
@@ -77,10 +78,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   std::string older_path;
   std::string newer_path;
-  CLI::App* report = app.add_subcommand("report", "two JSON reports: equal apart from wall_s, compute_us, memory_kb and "
+  CLI::App* report = app.add_subcommand("report", "two JSON reports: equal apart from provenance, wall_s, compute_us, memory_kb and "
                                                   "latencies; fields only the newer has are listed as added");
   CLI::App* journal = app.add_subcommand("journal", "two journals: equal byte for byte apart from the start times in "
-                                                    "the Start and Resume records and those records' CRC-32s");
+                                                    "the Start and Resume records and those records' CRC-32s, and the Provenance records");
   for (CLI::App* command : {report, journal}) {
     command->add_option("older", older_path, "what the older build wrote")->required();
     command->add_option("newer", newer_path, "what the newer build wrote")->required();

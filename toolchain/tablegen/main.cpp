@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "firmware/programs/installed_files.hpp"
 #include "firmware/services/report/build_version.hpp"
 #include "firmware/core/tables/table_format.hpp"
 #include "toolchain/tablegen/file_io.hpp"
@@ -105,7 +106,9 @@ int main(int argc, char** argv) {
   bool quiet = false;
   options.threads = std::max(1u, std::thread::hardware_concurrency());
 
-  app.add_option("part", part_path, "the part: an ASCII or binary STL file");
+  app.add_option("part", part_path,
+                 "the part: an ASCII or binary STL file, or sample:NAME for a shipped sample part (hex_prism, "
+                 "slotted_block, thin_fin: share/stencil/parts beside an installed program, else the build's parts/)");
   app.add_option("-o,--output", output_path, "the table to write (default: the part's name with .stbl, here)");
   app.add_option("--tool", tool_text,
                  "flat:d=D[,l=L] | ball:d=D[,l=L] | bull:d=D,r=RC[,l=L] (mm; flute length L defaults to 4*D)");
@@ -172,6 +175,14 @@ int main(int argc, char** argv) {
     std::cerr << "stencil-tablegen: expected a part and --tool, e.g. stencil-tablegen part.stl -o part.stbl "
                  "--tool ball:d=3\n(run stencil-tablegen --help for the options)\n";
     return 2;
+  }
+  {
+    std::string error;
+    part_path = stencil::app::resolve_sample_part(part_path, error);  // sample:NAME, from what ships
+    if (part_path.empty()) {
+      std::cerr << "stencil-tablegen: " << error << "\n";
+      return 2;
+    }
   }
   if (output_path.empty()) {
     output_path = std::filesystem::path(part_path).stem().string() + ".stbl";

@@ -18,6 +18,7 @@ bool open_job_journal(const JobJournalRequest& request, JournalWriter& writer, s
     JournalResume resume = request.resume;
     resume.unix_time_ns = now_ns;
     resume.program = request.program;
+    resume.provenance = request.provenance;
     if (!writer.open_to_resume(request.resume_path, request.resume_bytes, resume)) {
       error = writer.error();
       return false;
@@ -40,6 +41,7 @@ bool open_job_journal(const JobJournalRequest& request, JournalWriter& writer, s
   JournalStart start = request.start;
   start.unix_time_ns = now_ns;
   start.program = request.program;
+  start.provenance = request.provenance;
   if (!writer.open(path, start)) {
     error = writer.error();
     return false;

@@ -20,6 +20,7 @@ struct JobJournalRequest {
   std::size_t resume_bytes = 0;
   JournalStart start;        // a fresh journal's Start record (program and time filled in here)
   JournalResume resume;      // a resumed one's Resume record (program and time filled in here)
+  std::string provenance;    // what makes this run (report::provenance_line): after its Start or Resume
 };
 
 // Opens `writer` as asked (nothing with `none`); the path it writes goes to `opened_path` (empty:

@@ -13,7 +13,8 @@
 namespace stencil::journal {
 
 inline constexpr char kMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L', 'J'};
-inline constexpr std::uint32_t kVersion = 3;
+inline constexpr std::uint32_t kVersion = 4;  // 4: Provenance records (a version 3 journal is still carried on)
+inline constexpr std::uint32_t kProvenanceVersion = 4;
 inline constexpr std::uint32_t kOldestVersion = 2;  // no Command records, a SafeState without its source
 inline constexpr std::size_t kFileHeaderBytes = 12;
 inline constexpr std::size_t kRecordOverheadBytes = 9;  // length, type, CRC
@@ -30,6 +31,7 @@ enum class RecordType : std::uint8_t {
   Resume = 6,     // a resumed job's next segment starts here (its cycles count from 0 again)
   End = 7,        // the run ended in order (a run without one was killed or crashed)
   Command = 8,    // a command the cycle took (a stop, a reset, a pause, a parameter): before its cycle's record
+  Provenance = 9, // what made this run: right after its Start or Resume (version 4)
 };
 
 // Payload of Start: u32 tables' CRC-32, u32 triangle count, i64 start (ns since the Unix epoch),
@@ -56,6 +58,9 @@ inline constexpr std::uint32_t kHomedPayloadBytes = 8;
 inline constexpr std::uint32_t kMachineCommandPayloadBytes = 8 + 8 + 12 + 3 + 24;
 // Payload of End: u64 cycles the run made, u8 the safe reason it ended in (0: none, it finished).
 inline constexpr std::uint32_t kEndPayloadBytes = 9;
+// Payload of Provenance: u16 length and that many bytes of text (report::provenance_line: the program,
+// its version and compiler, the configuration's CRC-32, the tables' identity, the command line).
+inline constexpr std::size_t kMaxProvenanceBytes = 4000;
 // Payload of Resume: u32 segment (1 for the first resume), i64 start (ns since the Unix epoch),
 // f64 script_s and f64 approach_s (a simulated operator's: where its script carries on and how long
 // the way back to the cut takes first; 0 for a person), u16 program name length and its bytes.

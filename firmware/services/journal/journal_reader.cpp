@@ -298,9 +298,23 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         break;
       }
+      case RecordType::Provenance: {
+        const std::uint16_t text = body.u16();
+        if (version < kProvenanceVersion || body.overrun() || body.left() != text || text > kMaxProvenanceBytes) {
+          result.error = at(offset) + "a provenance record of " + std::to_string(length) + " bytes" +
+                         (version < kProvenanceVersion ? " in a version " + std::to_string(version) + " journal (version 4 has them)"
+                                                       : " that does not hold its text (a u16 length and at most 4000 bytes)");
+          return result;
+        }
+        if (visit.provenance) {
+          visit.provenance(std::string(reinterpret_cast<const char*>(body.here()), text));
+        }
+        break;
+      }
       default:
         result.error = at(offset) + "a record of type " + std::to_string(static_cast<int>(type)) +
-                       " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command, 6 resume or 7 end)";
+                       " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command, 6 resume, 7 end, "
+                       "8 command or 9 provenance)";
         return result;
     }
     ++result.records;

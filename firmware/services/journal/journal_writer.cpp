@@ -71,6 +71,7 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
   payload.u16(static_cast<std::uint16_t>(job_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(start.job.data()), job_length);
   add_record(RecordType::Start, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  add_provenance(start.provenance);
   const bool synced = sync_locked(lock);
   accepting_.store(synced);
   return synced;
@@ -89,9 +90,12 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
     return fail("cannot read its header", errno);
   }
   ByteReader version_bytes(header + sizeof kMagic, 4);
-  if (const std::uint32_t version = version_bytes.u32(); version != kVersion) {
-    return fail("is a version " + std::to_string(version) + " journal; this program carries on version " +
-                    std::to_string(kVersion) + " journals only (start the job afresh)",
+  // Version 3 differs only in having no Provenance records: carried on without them, it stays one.
+  const std::uint32_t version = version_bytes.u32();
+  if (version != kVersion && version + 1 != kProvenanceVersion) {
+    return fail("is a version " + std::to_string(version) + " journal; this program carries on versions " +
+                    std::to_string(kProvenanceVersion - 1) + " and " + std::to_string(kVersion) +
+                    " only (start the job afresh)",
                 0);
   }
   if (::ftruncate(fd_, static_cast<off_t>(good_bytes)) != 0) {
@@ -109,9 +113,23 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
   add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  if (version >= kProvenanceVersion) {
+    add_provenance(resume.provenance);
+  }
   const bool synced = sync_locked(lock);
   accepting_.store(synced);
   return synced;
+}
+
+void JournalWriter::add_provenance(const std::string& text) {
+  if (text.empty()) {
+    return;
+  }
+  const std::size_t length = std::min(text.size(), kMaxProvenanceBytes);
+  ByteWriter payload;
+  payload.u16(static_cast<std::uint16_t>(length));
+  payload.bytes(reinterpret_cast<const std::uint8_t*>(text.data()), length);
+  add_record(RecordType::Provenance, payload.data(), static_cast<std::uint32_t>(payload.size()));
 }
 
 bool JournalWriter::append_homed(std::int64_t time_ns) {

@@ -40,6 +40,7 @@ struct JournalStart {
   std::int64_t unix_time_ns = 0;
   std::string program;
   std::string job;  // at most 1024 bytes: the job's description, as the program gives it
+  std::string provenance;  // what made the run (report::provenance_line); "": no Provenance record
 };
 
 // A resumed job's next segment.
@@ -49,6 +50,7 @@ struct JournalResume {
   double script_s = 0.0;      // the simulated operator: its script carries on from here ...
   double approach_s = 0.0;    // ... after this long on the way back to the cut (0, 0: a person)
   std::string program;
+  std::string provenance;     // as JournalStart's (not written into a version 3 journal carried on)
 };
 
 class JournalWriter {
@@ -132,6 +134,7 @@ class JournalWriter {
   [[nodiscard]] bool sync_locked(std::unique_lock<std::mutex>& lock);
   [[nodiscard]] bool write_machine_commands_locked();
   void add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length);
+  void add_provenance(const std::string& text);  // a Provenance record, when there is a text
   [[nodiscard]] bool write_out();
   [[nodiscard]] bool fail(const std::string& what, int error_number);
 

@@ -124,6 +124,7 @@ Quantiles quantiles_of(const control::MicrosecondHistogram& histogram) {
 bool write_job_report(const std::string& path, const JobFigures& f, const nlohmann::json& board_sections,
                       std::string& error) {
   nlohmann::json report = {
+      {"provenance", provenance_json(f.provenance)},
       {"job", job_json(f)},
       {"cycles", f.cycles},
       {"overruns", f.overruns},

@@ -14,6 +14,7 @@
 #include "firmware/core/control/loop_statistics.hpp"
 #include "firmware/core/control/safe_state.hpp"
 #include "firmware/services/journal/job_history.hpp"
+#include "firmware/services/report/provenance.hpp"
 
 namespace stencil::report {
 
@@ -73,6 +74,7 @@ struct JobFigures {
   journal::JobHistory earlier;
   std::uint32_t touched_rebuilt = 0;
   OperatorRecord operator_record;
+  Provenance provenance;  // what made it: the report's "provenance" section
 };
 
 // The report: the figures as JSON, with `board_sections` merged in (an object; its keys add to the

@@ -38,11 +38,12 @@ function fail(message) {
   throw new Error(message);
 }
 
-// The journal's records (journal_format.hpp): Cycle, SafeState, MachineCommand and Command.
+// The journal's records (journal_format.hpp): Cycle, SafeState, MachineCommand and Command (the
+// others, Start, Homed, Provenance and End among them, are stepped over).
 function readJournal(file) {
   const b = fs.readFileSync(file);
-  if (b.toString('latin1', 0, 8) !== 'STENCILJ' || b.readUInt32LE(8) !== 3) {
-    fail(`${file}: not a version 3 journal`);
+  if (b.toString('latin1', 0, 8) !== 'STENCILJ' || b.readUInt32LE(8) !== 4) {
+    fail(`${file}: not a version 4 journal`);
   }
   const out = { cycles: [], safeStates: [], machine: [], commands: [] };
   let at = 12;
