@@ -13,7 +13,7 @@
 #include <CLI/CLI.hpp>
 
 #include "firmware/services/report/build_version.hpp"
-#include "firmware/programs/installed_files.hpp"
+#include "firmware/services/report/installed_files.hpp"
 #include "firmware/services/hmi/display_app.hpp"
 
 namespace {
@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     return kExitBadInput;
   }
   if (assets.empty()) {
-    assets = app::page_folder();
+    assets = report::page_folder();
   }
   options.web.assets_dir = assets;
   options.web.max_clients = max_clients;
@@ -93,6 +93,7 @@ int main(int argc, char** argv) {
   std::printf("display: %s%s (pid %d, controller %s)\n", display.url().c_str(),
               options.web.token.empty() ? "" : " (open it with ?token=... to change parameters)", static_cast<int>(getpid()),
               controller.c_str());
+  std::printf("display: the page from %s\n", assets.c_str());
   std::fflush(stdout);
   const auto started = std::chrono::steady_clock::now();
   while (g_stop == 0) {

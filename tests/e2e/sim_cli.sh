@@ -345,6 +345,48 @@ case_control_commands_reach_a_running_controller() {
   expect_stderr "no controller at .*control.sock" "that no controller is there"
 }
 
+# Installed (cmake --install, what the package holds), the programs find what ships beside them under
+# <prefix>/share/stencil, not in the build tree: the page, the sample parts; the units, the example
+# configuration and the man pages are there too.
+case_installed_programs_find_their_page_and_parts() {
+  local build prefix="$PWD/prefix" display_pid
+  build=$(cd "$(dirname "$sim")/.." && pwd)
+  run cmake --install "$build" --prefix "$prefix"
+  expect_status 0
+  if [ ! -x "$prefix/bin/stencil-sim" ]; then
+    echo "this build installs nothing (the sanitizers' build has no install rules): skipped"
+    exit 77
+  fi
+  for file in share/stencil/parts/hex_prism.stl share/stencil/examples/rig.toml lib/systemd/system/stencil-rig.service \
+              lib/systemd/system/stencil-display.service lib/udev/rules.d/60-stencil-uio.rules bin/stencil-rig \
+              bin/stencil-display bin/stencil-tablegen share/doc/stencil/README.md; do
+    [ -e "$prefix/$file" ] || fail "$file is not installed"
+  done
+  if [ -d "$build/hmi" ]; then
+    [ -e "$prefix/share/stencil/page/index.html" ] || fail "the page is not installed"
+  fi
+  if [ -d "$build/man" ]; then
+    [ -e "$prefix/share/man/man1/stencil-rig.1.gz" ] || fail "stencil-rig's man page is not installed"
+  fi
+  run "$prefix/bin/stencil-tablegen" sample:hex_prism --tool ball:d=3 -o hex.stbl --quiet
+  expect_status 0
+  [ -s hex.stbl ] || fail "no table from the installed sample part"
+  run "$prefix/bin/stencil-tablegen" sample:no_such_part --tool ball:d=3
+  expect_status 2
+  expect_stderr "no such sample part in $prefix/share/stencil/parts \\(expected sample:NAME with NAME one of" \
+    "where the installed parts are and which there are"
+  "$prefix/bin/stencil-display" --controller "$PWD/none.sock" --listen 127.0.0.1:0 >display.log 2>&1 &
+  display_pid=$!
+  for _ in $(seq 1 100); do grep -q "the page from" display.log && break; sleep 0.05; done
+  kill "$display_pid" 2>/dev/null
+  wait "$display_pid" 2>/dev/null
+  sed 's/^/  display: /' display.log
+  grep -q "display: the page from $prefix/share/stencil/page$" display.log || fail "the installed display does not serve the installed page"
+  run "$prefix/bin/stencil-sim" --fast --pattern raster --duration 1 --no-journal --report report.json --tables hex.stbl
+  expect_status 0
+  grep -q "\"$prefix/bin/stencil-sim\"" report.json || fail "the report's provenance does not name the installed program"
+}
+
 # The simulated device reached through the real PIO shared-memory and SocketCAN code: both wires
 # carry positions to the micrometre, so the two give the same report, and neither gouges.
 case_pio_and_can_give_the_same_result() {

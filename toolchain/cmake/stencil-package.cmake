@@ -20,7 +20,7 @@ endif()
 file(GLOB stencil_part_files ${PROJECT_SOURCE_DIR}/sim/parts/*.stl)
 install(FILES ${stencil_part_files} DESTINATION ${stencil_share}/parts)
 install(FILES ${PROJECT_SOURCE_DIR}/board/sherline_suzuki/rig.toml DESTINATION ${stencil_share}/examples)
-install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DOCDIR})
+install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/stencil)
 install(FILES ${PROJECT_SOURCE_DIR}/toolchain/package/stencil-rig.service ${PROJECT_SOURCE_DIR}/toolchain/package/stencil-display.service
         DESTINATION lib/systemd/system)
 install(FILES ${PROJECT_SOURCE_DIR}/toolchain/package/60-stencil-uio.rules DESTINATION lib/udev/rules.d)
@@ -65,6 +65,7 @@ set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_SECTION misc)
 set(CPACK_DEBIAN_PACKAGE_SHLIBDEPS ON)
+set(CPACK_STRIP_FILES ON)  # the programs without their symbols: a third of the size
 set(CPACK_DEBIAN_PACKAGE_DEPENDS "adduser")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
     ${PROJECT_SOURCE_DIR}/toolchain/package/postinst ${PROJECT_SOURCE_DIR}/toolchain/package/prerm

@@ -11,7 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "firmware/programs/installed_files.hpp"
+#include "firmware/services/report/installed_files.hpp"
 #include "firmware/services/report/build_version.hpp"
 #include "firmware/core/tables/table_format.hpp"
 #include "toolchain/tablegen/file_io.hpp"
@@ -178,7 +178,7 @@ int main(int argc, char** argv) {
   }
   {
     std::string error;
-    part_path = stencil::app::resolve_sample_part(part_path, error);  // sample:NAME, from what ships
+    part_path = stencil::report::resolve_sample_part(part_path, error);  // sample:NAME, from what ships
     if (part_path.empty()) {
       std::cerr << "stencil-tablegen: " << error << "\n";
       return 2;

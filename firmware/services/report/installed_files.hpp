@@ -5,7 +5,7 @@
 
 #include <string>
 
-namespace stencil::app {
+namespace stencil::report {
 
 // The first of <prefix>/share/stencil/<installed> and <build>/<in_build> that exists, where the
 // program runs from <prefix>/bin or <build>/bin; the installed path when neither does (for the message).
@@ -18,4 +18,4 @@ namespace stencil::app {
 // Anything not starting "sample:" is returned as it is.
 [[nodiscard]] std::string resolve_sample_part(const std::string& argument, std::string& error);
 
-}  // namespace stencil::app
+}  // namespace stencil::report

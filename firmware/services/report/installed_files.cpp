@@ -1,4 +1,4 @@
-#include "firmware/programs/installed_files.hpp"
+#include "firmware/services/report/installed_files.hpp"
 
 #include <filesystem>
 #include <system_error>
@@ -7,7 +7,7 @@
 #define STENCIL_INSTALL_DATADIR "share"
 #endif
 
-namespace stencil::app {
+namespace stencil::report {
 
 std::string shipped_path(const std::string& installed, const std::string& in_build) {
   std::error_code ec;
@@ -47,4 +47,4 @@ std::string resolve_sample_part(const std::string& argument, std::string& error)
   return "";
 }
 
-}  // namespace stencil::app
+}  // namespace stencil::report
