@@ -382,6 +382,26 @@ TEST(HmiTokenFile, OnlyAFileItsOwnerAloneMayReadGivesAToken) {
   CHECK_FALSE(read_token_file(link, token, error));  // never followed: it could point anywhere
 }
 
+// systemd's LoadCredential=: root's file with an ACL for the unit's user, so its mode shows the mask
+// (0440); taken as it is, but only straight from $CREDENTIALS_DIRECTORY.
+TEST(HmiTokenFile, ASystemdCredentialIsTakenAsSystemdLeftIt) {
+  Folder folder;
+  const std::string path = (folder.dir / "token").string();
+  std::ofstream(path) << "from-systemd\n";
+  chmod(path.c_str(), 0440);
+  std::string token, error;
+  CHECK_FALSE(read_token_file(path, token, error));
+  setenv("CREDENTIALS_DIRECTORY", folder.dir.c_str(), 1);
+  CHECK_TRUE_TEXT(read_token_file(path, token, error), error.c_str());
+  STRCMP_EQUAL("from-systemd", token.c_str());
+  std::filesystem::create_directory(folder.dir / "deeper");
+  const std::string deeper = (folder.dir / "deeper" / "token").string();
+  std::ofstream(deeper) << "x\n";
+  chmod(deeper.c_str(), 0440);
+  CHECK_FALSE(read_token_file(deeper, token, error));  // only the folder's own files
+  unsetenv("CREDENTIALS_DIRECTORY");
+}
+
 TEST_GROUP(DisplayApp) {
   void setup() override { MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads(); }
   void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }

@@ -38,7 +38,9 @@ namespace stencil::hmi {
 
 // The token from a file (its first line, without surrounding blanks) that only its owner, this
 // user, may read or write: a token never comes from the command line or the environment, where
-// other users' `ps` and /proc would see it. For a service, systemd's LoadCredential= gives such a file.
+// other users' `ps` and /proc would see it. For a service, systemd's LoadCredential= gives the file
+// in $CREDENTIALS_DIRECTORY, which systemd makes readable by the unit's user and root only (owned by
+// root with an ACL, so its mode shows the ACL's mask): a file there is taken as it is.
 // False with the reason (missing, another user's, readable by others, empty).
 [[nodiscard]] bool read_token_file(const std::string& path, std::string& token, std::string& error);
 
