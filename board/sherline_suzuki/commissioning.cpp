@@ -148,4 +148,17 @@ CommissioningResult commission(const RigFacts& facts, const CommissioningSetting
   return result;
 }
 
+std::string describe(const CommissioningResult& result) {
+  std::string text;
+  for (const std::string& finding : result.findings) {
+    text += "commissioning: " + finding + "\n";
+  }
+  if (!result.backlash_line.empty()) {
+    text += "commissioning: measured " + result.backlash_line + "\n";
+  }
+  text += result.passed ? "commissioning: passed: the configuration agrees with the mill\n"
+                        : "commissioning: FAILED: correct the configuration before any cut\n";
+  return text;
+}
+
 }  // namespace stencil::board::sherline_suzuki

@@ -51,4 +51,8 @@ struct CommissioningResult {
                                              hal::cy545::Cy545Link& link, hal::Clock& clock,
                                              CommissioningOperator& machinist, const std::atomic<bool>* interrupted);
 
+// What it found, for the machinist: a line per finding, the measured backlash line, and the verdict,
+// each line starting "commissioning: ".
+[[nodiscard]] std::string describe(const CommissioningResult& result);
+
 }  // namespace stencil::board::sherline_suzuki

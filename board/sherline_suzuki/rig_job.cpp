@@ -80,9 +80,12 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
   control::ControllerConfig config = runtime::controller_config(
       {rig_frames(job.offset, f), device_workspace_mm, f.device_reach_margin_mm, f.force_limit_n, f.torque_limit_nmm,
        1.0 / f.haptic_rate_hz, f.virtual_tool_speed_mm_per_s, f.machine_standoff_mm, true});
-  config.start_held = job.start_held;  // no tool motion and no force until the hand is held still near the tool
-  config.overrun_limit = job.overrun_limit;
-  config.stale_periods = job.stale_periods;
+  // facts.overrun_limit, stale_periods and start_held: the configuration's (the tests' fakes on hosts
+  // that are not real-time raise the first two, and their scripted hands, moving from the start, turn
+  // the held start off).
+  config.start_held = job.facts.start_held;  // no tool motion and no force until the hand is held still near the tool
+  config.overrun_limit = job.facts.overrun_limit;
+  config.stale_periods = job.facts.stale_periods;
   return config;
 }
 

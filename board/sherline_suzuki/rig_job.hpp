@@ -57,15 +57,6 @@ struct RigJob {
   // SIGINT, SIGTERM, SIGHUP, SIGQUIT: a stop command to the cycle, and homing given up between commands.
   const std::atomic<bool>* interrupted = nullptr;
   double duration_s = 0.0;                          // 0: until interrupted or a safe state
-  // More overruns in a row than this is a safe state: 3 on the rig. The tests raise it, since the
-  // hosts they run on are not real-time hosts (make latency measures what a host gives).
-  int overrun_limit = kRig.overrun_limit;
-  // The cycle starts held (no tool motion, no force) until the hand is held still near the tool, as
-  // for a reset: on the rig always; the tests' scripted hands, which move from the start, turn it off.
-  bool start_held = kRig.start_held;
-  // More periods than this without a fresh device sample is a safe state: 5 on the rig (the tests
-  // raise it for the same reason: their simulated device is a thread on a host that stalls).
-  int stale_periods = kRig.stale_periods;
   std::function<void(const std::string&)> progress;  // a line about every second, and every event
   // Once homed, before the spindle starts: blocks until the operator confirms (true) or the job is
   // to end (false: the mill stays homed with the spindle off and the run ends). Null: no confirmation.

@@ -5,7 +5,7 @@
 
 namespace stencil::board::sim {
 MillWiring::MillWiring(const SimJob& job, bool realtime)
-    : mill_{mill_config(job.rig.mill_truth, job.rig.facts)},
+    : mill_{mill_config(job.rig.mill_truth)},
       epoch_ns_(realtime ? hal::posix_clock::monotonic_now_ns() : 0),
       fake_{mill_, job.rig.mill_truth.mmc4s, epoch_ns_},
       relay_ns_(job.rig.mill_truth.watchdog_relay_timeout_ns),

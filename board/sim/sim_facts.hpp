@@ -27,43 +27,23 @@ struct SimRig {
   rig::RigFacts mill_truth = rig::kRig;
 };
 
-// The frames: world = device / 10, device space [0,500]x[0,250]x[0,250]; the machine homes with the
-// tool at the workspace's far top corner (its X and Y switches at the table's travel end, Z at the
-// top), so every axis counts from there into the workspace.
-inline constexpr double kDeviceMmPerWorldMm = rig::kRig.haptic_to_machine_scale;
-inline constexpr std::array<double, 3> kHomeWorldMm = rig::kHomeWorldMm;
-inline constexpr hal::HapticRange kDeviceRange = rig::kDeviceRange;
+// The frames, speeds, planner, standoff and model cell of a job come from its SimRig (sim_job.hpp's
+// functions of it); the constants below are the compiled-in rig's, for what is built before a job is.
 
-// The cycle's period, the machine's update and what the planner may spend in one: the rig's.
+// The simulated device samples at the compiled-in cycle's rate (device_process: --device-process).
 inline constexpr hal::MonotonicNs kPeriodNs = rig::kPeriodNs;
-inline constexpr hal::MonotonicNs kUpdateNs = rig::kUpdateNs;
-inline constexpr motion::PlannerLimits kPlannerLimits = rig::kPlannerLimits;
-
-// What the mill really follows: the rig's virtual tool speed (rig_facts.hpp says why it is under the
-// mill's stepping). The scripted hand moves a little slower than that (0.8 of it), so that the
-// virtual tool keeps up with it and a scripted job is not a tug against the speed limit.
-inline constexpr double kVirtualToolSpeedMmPerS = rig::kRig.virtual_tool_speed_mm_per_s;
-// The virtual tool keeps this clear of the part: stock the job means to leave (not unmachined).
-inline constexpr double kStandoffMm = rig::kRig.machine_standoff_mm;
-inline constexpr double kOperatorSpeedMmPerS = 0.8 * kVirtualToolSpeedMmPerS;
-
-// The controller's model of the machined stock: the rig's cells, as fine as the simulated mill's Z-map.
-inline constexpr double kModelCellMm = rig::kRig.stock_model_cell_mm;
 
 // The serial line: the rig's baud rate (the port opens at it; on virtual time the fake's bytes take
 // their wire time at it).
 inline constexpr std::uint32_t kBaud = rig::kRig.serial_baud;
 
-// The simulated rig's hardware watchdog relay: the rig's, on the rig's heartbeat output.
-inline constexpr hal::MonotonicNs kWatchdogRelayNs = rig::kRig.watchdog_relay_timeout_ns;
-
-// The simulated Sherline mill: the rig's steps, backlash, hard stops and home switches (`truth`: the
-// mill as it is, which a test may make differ from what the controller's configuration `believed`
-// says); it powers up in mid-workspace with the slack on the negative side (as after a positive
+// The simulated Sherline mill: the rig's steps, backlash, hard stops and home switches as the mill
+// really is (`truth`, which a test may make differ from what the controller's configuration says:
+// the driver applies the configured wiring on its side of the line); it powers up in mid-workspace with the slack on the negative side (as after a positive
 // move), so that homing has a way to go on every axis. Its direction lines are wired as the truth's
 // step_direction says: where the configuration says otherwise, that axis runs the other way from
 // what the driver commands.
-inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth, const rig::RigFacts& believed) {
+inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth) {
   stencil::sim::MillConfig config{};
   config.steps_per_mm = truth.steps_per_mm;
   for (int axis = 0; axis < rig::kAxisCount; ++axis) {
@@ -76,10 +56,9 @@ inline constexpr stencil::sim::MillConfig mill_config(const rig::RigFacts& truth
     c.initial_position_steps = rig::mm_to_steps(truth.workspace_mm[a] / 2.0, truth);
     c.motor_direction = truth.mmc4s.step_direction[a];  // the mill's direction lines as they are wired
   }
-  static_cast<void>(believed);  // the driver applies the configured wiring on its side of the line
   return config;
 }
-inline constexpr stencil::sim::MillConfig kMillConfig = mill_config(rig::kRig, rig::kRig);
+inline constexpr stencil::sim::MillConfig kMillConfig = mill_config(rig::kRig);
 
 // The MMC-4S board's wiring, for the fake CY545's board and the driver alike: the rig's.
 inline constexpr hal::cy545::Mmc4sWiring kMmc4sWiring = rig::kRig.mmc4s;

@@ -209,14 +209,7 @@ int commission(const app::RigOptions& o) {
   app::TerminalMachinist machinist(&interrupted);
   const board::sherline_suzuki::CommissioningResult result = board::sherline_suzuki::commission(
       o.config.facts, o.config.commissioning, *devices.link, devices.clock, machinist, &interrupted);
-  for (const std::string& finding : result.findings) {
-    std::printf("stencil-rig: commissioning: %s\n", finding.c_str());
-  }
-  if (!result.backlash_line.empty()) {
-    std::printf("stencil-rig: commissioning: measured %s\n", result.backlash_line.c_str());
-  }
-  std::printf("stencil-rig: commissioning %s\n", result.passed ? "passed: the configuration agrees with the mill"
-                                                              : "FAILED: correct the configuration before any cut");
+  std::printf("%s", board::sherline_suzuki::describe(result).c_str());
   return result.passed ? 0 : kExitNotStarted;
 }
 
@@ -283,9 +276,6 @@ int main(int argc, char** argv) {
                                                job.facts, fit, error)) {
     return fail(kExitBadInput, error);
   }
-  job.overrun_limit = job.facts.overrun_limit;
-  job.stale_periods = job.facts.stale_periods;
-  job.start_held = job.facts.start_held;
   std::printf("stencil-rig: tables %s: %u points, %u triangles\n", o.tables_path.c_str(), part.point_count(),
               part.triangle_count());
   const app::RtReadiness readiness = app::check_rt_readiness(bytes.size() + (64U << 20), o.priority);

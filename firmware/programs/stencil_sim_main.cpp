@@ -228,14 +228,7 @@ double operator_speed_mm_per_s(const board::sim::SimRig& rig) { return 0.8 * rig
 int commission(const app::SimOptions& o, const board::sim::SimJob& job) {
   const board::sherline_suzuki::CommissioningResult result = board::sim::commission_simulated_rig(
       job, o.commissioning, &interrupted, [](const std::string& line) { std::printf("%s\n", line.c_str()); });
-  for (const std::string& finding : result.findings) {
-    std::printf("commissioning: %s\n", finding.c_str());
-  }
-  if (!result.backlash_line.empty()) {
-    std::printf("commissioning: measured %s\n", result.backlash_line.c_str());
-  }
-  std::printf("commissioning: %s\n", result.passed ? "passed: the configuration agrees with the mill"
-                                                    : "FAILED: correct the configuration before any cut");
+  std::printf("%s", board::sherline_suzuki::describe(result).c_str());
   return result.passed ? 0 : kExitSafeState;
 }
 

@@ -33,7 +33,7 @@ struct Bench {
 
   Bench(const rig::RigFacts& configured_facts, const rig::RigFacts& truth)
       : configured(configured_facts),
-        mill(board::sim::mill_config(truth, configured_facts)),
+        mill(board::sim::mill_config(truth)),
         fake(mill, truth.mmc4s, 0),
         clock(fake, 0, configured_facts.serial_baud),
         link(port, clock, board::sim::link_config(false, configured_facts)) {

@@ -115,7 +115,7 @@ struct FakeRig {
 
   rig::RigJob job(double duration_s) {
     rig::RigJob j;
-    j.start_held = false;  // the scripted hands move from the first millisecond (the held start: control_tests)
+    j.facts.start_held = false;  // the scripted hands move from the first millisecond (the held start: control_tests)
     j.part = &part;
     j.device = host.get();
     j.machine = link.get();
@@ -124,8 +124,8 @@ struct FakeRig {
     j.duration_s = duration_s;
     // Not a real-time host: overruns are counted but do not end the run here (the overrun storm has
     // its own test in tests/control).
-    j.overrun_limit = 1'000'000;
-    j.stale_periods = 100;  // 0.1 s: a stalled thread here is not a disconnected device
+    j.facts.overrun_limit = 1'000'000;
+    j.facts.stale_periods = 100;  // 0.1 s: a stalled thread here is not a disconnected device
     return j;
   }
 

@@ -91,7 +91,11 @@ int read_and_check(const std::uint8_t* data, std::size_t size) {
         require(static_cast<int>(reason) <= static_cast<int>(stencil::control::SafeReason::Stopped));
         ++visits;
       },
-      [&](std::size_t offset) { require(offset >= stencil::journal::kFileHeaderBytes && offset < size); }};
+      [&](std::size_t offset) { require(offset >= stencil::journal::kFileHeaderBytes && offset < size); },
+      [&](const std::string& text) {
+        require(text.size() <= stencil::journal::kMaxProvenanceBytes);
+        ++visits;
+      }};
   const stencil::journal::JournalReadResult read = stencil::journal::read_journal(data, size, visitor);
   require(read.ok == read.error.empty());
   require(visits == read.records);

@@ -23,9 +23,9 @@ struct JournalVisitor {
   std::function<void(std::int64_t time_ns)> homed;
   std::function<void(const control::MachineCommandRecord&)> machine_command;
   std::function<void(const JournalResume&)> resume;
-  std::function<void(const std::string& provenance)> provenance;  // after its run's start or resume
   std::function<void(std::uint64_t cycles, control::SafeReason reason)> end;
   std::function<void(std::size_t offset)> offset;  // before each whole record's own callback: where it starts
+  std::function<void(const std::string& provenance)> provenance;  // after its run's start or resume
 };
 
 struct JournalReadResult {
