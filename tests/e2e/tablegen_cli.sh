@@ -156,6 +156,26 @@ check_json() {
 }
 
 # ---------------------------------------------------------------------------------------------------
+# A shipped sample part by name (sample:NAME): from the build tree's parts/ here (installed, from
+# share/stencil/parts: e2e.sim_installed_programs_find_their_page_and_parts); an unknown name is
+# refused naming where it looked and which there are, and nothing is written.
+
+case_sample_part_by_name() {
+  local build
+  build=$(cd "$(dirname "$tablegen")/.." && pwd)
+  tablegen sample:thin_fin --tool ball:d=3 -o fin.stbl --quiet
+  expect_status 0
+  [ -s fin.stbl ] || fail "no table from sample:thin_fin"
+  tablegen "$build/parts/thin_fin.stl" --tool ball:d=3 -o by_path.stbl --quiet
+  cmp -s fin.stbl by_path.stbl || fail "sample:thin_fin is not the build tree's parts/thin_fin.stl"
+  tablegen sample:no_such --tool ball:d=3 -o none.stbl
+  expect_status 2
+  expect_stderr "sample:no_such: no such sample part in $build/parts \\(expected sample:NAME with NAME one of .*thin_fin" \
+    "where it looked and which parts there are"
+  [ ! -e none.stbl ] || fail "a table was written for an unknown sample"
+}
+
+# ---------------------------------------------------------------------------------------------------
 # Bad STL input: exit 2, the file and the place named, nothing written.
 
 case_empty_stl_is_refused() {
