@@ -19,7 +19,7 @@ help:
 	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
 	@echo "make package    the Debian package (CPack): build/stencil_<version>_<arch>.deb"
-	@echo "make package-check install, use and purge that package in a clean Debian 12 root (mmdebstrap; needs root; a few minutes)"
+	@echo "make package-check install, use and purge that package in a clean Debian 12 root (mmdebstrap; needs root; about two minutes)"
 	@echo "make fresh-check README's two commands in a clean Debian 12 root (mmdebstrap; needs root; about half an hour)"
 	@echo "make fuzz       build the libFuzzer targets with clang (build/fuzz) and fuzz each for FUZZ_SECONDS (60)"
 	@echo "make clean      remove build/"
@@ -108,9 +108,6 @@ same-behaviour:
 	@$(MAKE) --no-print-directory build
 	bash toolchain/same-behaviour.sh $(OLD) build
 
-# A check, not a test: README's two commands in a clean Debian 12 root made with mmdebstrap, the
-# committed HEAD cloned into it (toolchain/fresh-check.sh; needs root). Run it after any change to
-# the dependencies, the lock file or install-deps.sh.
 # The Debian package of the programs, the page, the sample parts and the services (CPack's DEB
 # generator; toolchain/cmake/stencil-package.cmake).
 package: build
@@ -122,6 +119,9 @@ package-check: package
 	@bash toolchain/install-deps.sh --fresh-check
 	ctest --preset package
 
+# A check, not a test: README's two commands in a clean Debian 12 root made with mmdebstrap, the
+# committed HEAD cloned into it (toolchain/fresh-check.sh; needs root). Run it after any change to
+# the dependencies, the lock file or install-deps.sh.
 fresh-check:
 	@bash toolchain/install-deps.sh --fresh-check
 	bash toolchain/fresh-check.sh build/fresh-check

@@ -87,6 +87,15 @@ for file in /usr/bin/stencil-sim /usr/bin/stencil-rig /usr/bin/stencil-display /
   [ -e "$root$file" ] || fail "$file is not installed"
 done
 
+step "the maintainer scripts again (dpkg-reconfigure): what the machinist set is kept"
+echo '# edited by the machinist' >>"$root/etc/stencil/rig.toml"
+sums_before=$(cd "$root/etc/stencil" && sha256sum rig.toml display.token job.env)
+in_root dpkg-reconfigure stencil || fail "dpkg-reconfigure stencil"
+[ "$(cd "$root/etc/stencil" && sha256sum rig.toml display.token job.env)" = "$sums_before" ] ||
+  fail "running postinst again changed /etc/stencil"
+sed -i '$d' "$root/etc/stencil/rig.toml"
+echo "/etc/stencil kept: $(ls "$root/etc/stencil" | tr '\n' ' ')"
+
 step "stencil-sim --version"
 in_root stencil-sim --version || fail "stencil-sim --version"
 
@@ -116,15 +125,30 @@ as_user 'stencil-rig stop --socket ~/control.sock' || fail "stencil-rig stop"
 for _ in $(seq 1 100); do grep -q '^report:' "$root/home/machinist/sim.log" && break; sleep 0.1; done
 grep -E '^(safe state|report)' "$root/home/machinist/sim.log" | sed 's/^/  stencil-sim: /'
 
+step "a job left for the service as a machinist would: the display enabled, the part's tables and a run"
+in_root systemctl enable stencil-display.service || fail "systemctl enable stencil-display"
+[ -L "$root/etc/systemd/system/multi-user.target.wants/stencil-display.service" ] || fail "the display is not enabled"
+cp "$root/home/machinist/hex.stbl" "$root/var/lib/stencil/part.stbl"
+cp "$root"/home/machinist/stencil-sim-*.journal "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000.journal"
+in_root chown -R stencil:stencil /var/lib/stencil
+
 step "purge"
 in_root apt-get purge -y stencil >"$work/purge.log" 2>&1 || { cat "$work/purge.log"; fail "apt-get purge"; }
 in_root dpkg-query -W stencil >/dev/null 2>&1 && fail "dpkg still knows the package"
 in_root getent passwd stencil >/dev/null && fail "the service user is still there"
+[ -e "$root/etc/systemd/system/multi-user.target.wants/stencil-display.service" ] && fail "the display is still enabled"
 left=$(cd "$root" && find . -xdev \( -path ./proc -o -path ./sys -o -path ./dev -o -path ./tmp \) -prune -o \
   \( -iname '*stencil*' -print \) 2>/dev/null | grep -v '^./var/lib/dpkg/' || true)
-echo "left with 'stencil' in its name:"
-echo "${left:-  (nothing)}" | sed 's/^/  /'
-if grep -v '^./home/' <<<"$left" | grep -q .; then fail "the purge left files outside the users' homes"; fi
+echo "left with 'stencil' in its name (and what is in /var/lib/stencil):"
+echo "${left:-(nothing)}" | sed 's/^/  /'
+(cd "$root" && find ./var/lib/stencil -printf '  %p %u:%g\n' 2>/dev/null) || true
+# The runs only: users' in their homes, the service's in /var/lib/stencil (its journals and the tables
+# they were cut from), given to root.
+if grep -vE '^\./(home/|var/lib/stencil($|/))' <<<"$left" | grep -q .; then fail "the purge left files besides the runs"; fi
+[ -f "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000.journal" ] || fail "the purge took the service's run"
+if [ -n "$(cd "$root" && find ./var/lib/stencil ! -user root 2>/dev/null)" ]; then
+  fail "files in /var/lib/stencil still belong to the removed user"
+fi
 
 unmount_root
 if [ "$remove_root" -eq 1 ]; then rm -rf --one-file-system "$root"; fi

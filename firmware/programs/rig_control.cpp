@@ -28,7 +28,8 @@ struct Verb {
 };
 constexpr Verb kVerbs[] = {
     {"status", MessageKind::Hello, "print the running job's state: cycle, safe state and its source, pause, the mill's position"},
-    {"stop", MessageKind::Stop, "the safe state now: no force, the mill held and stopped (as the terminal's 'stop')"},
+    {"stop", MessageKind::Stop, "the safe state now: no force, the mill held and stopped (as the terminal's 'stop'); "
+                                "before the cut, the end of the wait for 'start' with nothing cut"},
     {"reset", MessageKind::Reset, "leave the safe state (taken only with the handle held still near the tool)"},
     {"pause", MessageKind::Pause, "feed hold: the tool and the mill held where they are"},
     {"resume", MessageKind::Resume, "carry on after a pause"},

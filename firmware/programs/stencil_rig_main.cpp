@@ -126,15 +126,16 @@ void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& ter
                 "spindle on (Ctrl-C ends)%s%s\n", link != nullptr ? ", or send it: stencil-rig start --socket " : "",
                 link != nullptr ? link->socket_path().c_str() : "");
     std::fflush(stdout);
+    using Answer = display_link::DisplayLink::StartAnswer;
     if (link != nullptr) {
-      link->await_start(true);
+      link->await_start();
     }
     bool closed_said = false;
-    bool started = false;
-    while (!interrupted.load() && !started) {
+    bool typed = false;
+    while (!interrupted.load() && !typed && (link == nullptr || link->start_answer() == Answer::None)) {
       const app::TerminalCommands::Word word = terminal.next_word();
-      started = word == app::TerminalCommands::Word::Start || (link != nullptr && link->take_start());
-      if (!started && word == app::TerminalCommands::Word::Closed && !closed_said) {
+      typed = word == app::TerminalCommands::Word::Start;
+      if (!typed && word == app::TerminalCommands::Word::Closed && !closed_said) {
         if (link == nullptr) {
           std::fprintf(stderr, "stencil-rig: no operator at the terminal (its input is closed): the spindle stays off\n");
           return false;
@@ -142,14 +143,17 @@ void wire_operator(RigJob& job, int machine_priority, app::TerminalCommands& ter
         std::fprintf(stderr, "stencil-rig: no terminal: waiting for 'stencil-rig start' on %s\n", link->socket_path().c_str());
         closed_said = true;
       }
-      if (!started) {
+      if (!typed) {
         usleep(100'000);
       }
     }
-    if (link != nullptr) {
-      link->await_start(false);
+    // Whatever the link took up to this moment decides with the terminal: a stop wins.
+    const Answer answer = link != nullptr ? link->end_start_wait() : Answer::None;
+    if (answer == Answer::Stop) {
+      std::fprintf(stderr, "stencil-rig: stopped before the cut (a stop through the socket): the spindle stays off\n");
+      return false;
     }
-    return started;
+    return !interrupted.load() && (typed || answer == Answer::Start);
   };
 }
 

@@ -163,8 +163,8 @@ TEST(DisplayLink, RequestsAreDecidedOnTheControllersSideAndAcceptedOnesReachTheC
 }
 
 // The spindle's start through the link (a service has no terminal): refused unless the program is
-// waiting for it, then taken once by the program, never as a cycle command.
-TEST(DisplayLink, AStartIsTakenOnceByTheWaitingProgramAndNeverReachesTheCycle) {
+// waiting for it, then taken once by the program, never as a cycle command; a stop ends the wait.
+TEST(DisplayLink, AStartIsTakenOnceByTheWaitingProgramAndAStopEndsTheWait) {
   Prism prism;
   Folder folder;
   DisplayLink link(prism.part, config(), {folder.socket(), "stencil-test", false});
@@ -177,19 +177,32 @@ TEST(DisplayLink, AStartIsTakenOnceByTheWaitingProgramAndNeverReachesTheCycle) {
   CHECK_EQUAL(1U, answers.size());
   CHECK(static_cast<MessageKind>(answers[0].kind) == MessageKind::Refused);
   STRCMP_CONTAINS("not waiting for a start", reason_of(answers[0]).c_str());
-  CHECK_FALSE(link.take_start());
+  using Answer = DisplayLink::StartAnswer;
+  CHECK(link.start_answer() == Answer::None);
 
-  link.await_start(true);
+  link.await_start();
+  CHECK(link.start_answer() == Answer::None);
   CHECK(client.send(make_message(MessageKind::Start, 2)));
   CHECK(client.send(make_message(MessageKind::Start, 3)));
   answers = poll_until(client, [](const auto& a) { return a.size() >= 2; });
   CHECK_EQUAL(2U, answers.size());
   CHECK(static_cast<MessageKind>(answers[0].kind) == MessageKind::Accepted);
   CHECK(static_cast<MessageKind>(answers[1].kind) == MessageKind::Refused);  // once only
-  CHECK_TRUE(link.take_start());
-  CHECK_FALSE(link.take_start());
+  CHECK(link.start_answer() == Answer::Start);
+  CHECK(link.end_start_wait() == Answer::Start);
+  CHECK(link.start_answer() == Answer::None);  // the wait is over
   control::Command command{};
   CHECK_FALSE(link.commands().pop(command));
+
+  // A stop while the start is awaited ends the wait: nothing is cut (and it reaches the ring as ever).
+  link.await_start();
+  CHECK(client.send(make_message(MessageKind::Stop, 4)));
+  answers = poll_until(client, [](const auto& a) { return !a.empty(); });
+  CHECK_EQUAL(1U, answers.size());
+  CHECK(static_cast<MessageKind>(answers[0].kind) == MessageKind::Accepted);
+  CHECK(link.end_start_wait() == Answer::Stop);
+  CHECK(link.commands().pop(command));
+  CHECK(command.kind == control::CommandKind::Stop);
 }
 
 TEST(DisplayLink, WhenTheControllerEndsTheDisplayKeepsItsLastStateAndSaysHow) {

@@ -314,9 +314,9 @@ case_control_commands_reach_a_running_controller() {
     --report report.json >sim.log 2>&1 &
   sim_pid=$!
   for _ in $(seq 1 300); do [ -S "$socket" ] && break; sleep 0.02; done
-  # Homing first: the job runs once the cycle has made records.
+  # Homing first: the job runs once the cycle has made records and told its state (the force line).
   for _ in $(seq 1 100); do
-    "$rig" status --socket "$socket" 2>/dev/null | grep -q "^job: running" && break
+    "$rig" status --socket "$socket" 2>/dev/null | grep -q "^force:" && break
     sleep 0.1
   done
   run_rig status --socket "$socket"

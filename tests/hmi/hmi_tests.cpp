@@ -359,7 +359,9 @@ TEST(HmiLiveState, TheEndOfTheJobIsShownWithItsLastState) {
   CHECK_EQUAL(9U, frame["cycle"].get<std::uint64_t>());
 }
 
-TEST_GROUP(HmiTokenFile){};
+TEST_GROUP(HmiTokenFile) {
+  void teardown() override { unsetenv("CREDENTIALS_DIRECTORY"); }  // however a test ended
+};
 
 TEST(HmiTokenFile, OnlyAFileItsOwnerAloneMayReadGivesAToken) {
   Folder folder;

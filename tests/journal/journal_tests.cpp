@@ -517,12 +517,12 @@ TEST(Journal, AVersion2JournalStillReadsButIsNotCarriedOn) {
   JournalResume resume;
   resume.segment = 1;
   CHECK_FALSE(writer.open_to_resume(file.path, read.good_bytes, resume));
-  STRCMP_CONTAINS("is a version 2 journal; this program carries on versions 3 and 4 only", writer.error().c_str());
+  STRCMP_CONTAINS("is a version 2 journal; this program carries on versions 3 to 4 only", writer.error().c_str());
 }
 
-// Which build made each run, after its Start and each Resume; a version 3 journal (none) is carried on
-// without them, so it stays a version 3 journal.
-TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnWithoutIt) {
+// Which build made each run, after its Start and each Resume; a version 3 journal (none, and every
+// record of it a version 4 record) is carried on as version 4, its resumed run saying what made it.
+TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion4) {
   TempJournal file;
   {
     JournalWriter writer;
@@ -552,7 +552,7 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnWithoutIt) {
   CHECK_EQUAL(2U, both.provenances.size());
   STRCMP_EQUAL("journal_tests v2; command: journal_tests --resume", both.provenances[1].c_str());
 
-  // A version 3 journal: the same records without Provenance, carried on without one.
+  // A version 3 journal: the same records without Provenance.
   write_job(file.path, 3);
   std::vector<std::uint8_t> bytes = file.bytes();
   bytes[8] = 3;
@@ -572,8 +572,10 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnWithoutIt) {
   read = read_journal_file(file.path, old.visitor());
   CHECK_TEXT(read.ok, read.error.c_str());
   CHECK_EQUAL(1U, old.resumes.size());
-  CHECK_EQUAL(0U, old.provenances.size());
-  CHECK_EQUAL(3U, file.bytes()[8]);
+  CHECK_EQUAL(3U, old.cycles.size());
+  CHECK_EQUAL(1U, old.provenances.size());
+  STRCMP_EQUAL("journal_tests v2", old.provenances[0].c_str());
+  CHECK_EQUAL(4U, file.bytes()[8]);
 
   // A provenance record in a version 3 journal is damage, named by its offset.
   {
@@ -589,6 +591,38 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnWithoutIt) {
   read = read_journal(bytes.data(), bytes.size(), damaged.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_CONTAINS("a provenance record of 3 bytes in a version 3 journal", read.error.c_str());
+
+  // Only right after its run's start or resume, once; its length must hold its text.
+  {
+    JournalWriter writer;
+    JournalStart start = start_of();
+    start.provenance = "made by";
+    CHECK_TRUE(writer.open(file.path, start));
+    CHECK_TRUE(writer.append(record_of(0)));
+    CHECK_TRUE(writer.close());
+  }
+  bytes = file.bytes();
+  const std::size_t start_record = kFileHeaderBytes;
+  const std::size_t provenance_at = start_record + kRecordOverheadBytes + (bytes[start_record] | (bytes[start_record + 1] << 8));
+  const std::size_t provenance_length = kRecordOverheadBytes + 2 + 7;
+  CHECK_EQUAL(static_cast<int>(RecordType::Provenance), bytes[provenance_at + 4]);
+  std::vector<std::uint8_t> twice(bytes.begin(), bytes.begin() + static_cast<long>(provenance_at + provenance_length));
+  twice.insert(twice.end(), bytes.begin() + static_cast<long>(provenance_at), bytes.end());
+  Seen repeated;
+  read = read_journal(twice.data(), twice.size(), repeated.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS(("journal offset " + std::to_string(provenance_at + provenance_length) +
+                   ": a provenance record not right after a start or resume record").c_str(), read.error.c_str());
+  std::vector<std::uint8_t> short_text = bytes;
+  short_text[provenance_at + 5] = 9;  // the text's length: 9 of the 7 bytes there
+  const uLong crc = crc32(crc32(0L, Z_NULL, 0), short_text.data() + provenance_at, static_cast<uInt>(5 + 2 + 7));
+  for (int b = 0; b < 4; ++b) {
+    short_text[provenance_at + 5 + 2 + 7 + static_cast<std::size_t>(b)] = static_cast<std::uint8_t>(crc >> (8 * b));
+  }
+  Seen wrong;
+  read = read_journal(short_text.data(), short_text.size(), wrong.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("a provenance record of 9 bytes that does not hold its text", read.error.c_str());
 }
 
 TEST(Journal, ACommandRecordOutOfRangeIsAnErrorNamingTheOffset) {

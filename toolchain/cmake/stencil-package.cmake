@@ -21,8 +21,16 @@ file(GLOB stencil_part_files ${PROJECT_SOURCE_DIR}/sim/parts/*.stl)
 install(FILES ${stencil_part_files} DESTINATION ${stencil_share}/parts)
 install(FILES ${PROJECT_SOURCE_DIR}/board/sherline_suzuki/rig.toml DESTINATION ${stencil_share}/examples)
 install(FILES ${PROJECT_SOURCE_DIR}/README.md DESTINATION ${CMAKE_INSTALL_DATADIR}/doc/stencil)
-install(FILES ${PROJECT_SOURCE_DIR}/toolchain/package/stencil-rig.service ${PROJECT_SOURCE_DIR}/toolchain/package/stencil-display.service
-        DESTINATION lib/systemd/system)
+# The units name the programs where this install puts them (@BINDIR@ at install time: /usr/bin in the
+# package, <prefix>/bin for cmake --install --prefix). systemd and udev read only /usr/lib and /etc:
+# the units and the rule take effect from the package (prefix /usr).
+foreach(unit IN ITEMS stencil-rig.service stencil-display.service)
+  install(CODE "
+    set(BINDIR \"\${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}\")
+    configure_file(\"${PROJECT_SOURCE_DIR}/toolchain/package/${unit}\" \"${CMAKE_BINARY_DIR}/units/${unit}\" @ONLY)
+    file(INSTALL DESTINATION \"\${CMAKE_INSTALL_PREFIX}/lib/systemd/system\" TYPE FILE
+         FILES \"${CMAKE_BINARY_DIR}/units/${unit}\")")
+endforeach()
 install(FILES ${PROJECT_SOURCE_DIR}/toolchain/package/60-stencil-uio.rules DESTINATION lib/udev/rules.d)
 
 # Man pages from each program's --help and --version (help2man, a build tool: toolchain/install-deps.sh).

@@ -142,12 +142,17 @@ std::string DisplayLink::decide(const Request& request) {
     return refusal(request, own_view_.header().limits);
   }
   if (request.kind == RequestKind::Start) {
-    bool awaiting = true;
-    if (!awaiting_start_.compare_exchange_strong(awaiting, false)) {
+    std::uint8_t awaiting = kAwaiting;
+    if (!start_wait_.compare_exchange_strong(awaiting, kStarted)) {
       return "not waiting for a start: the spindle is started once, after homing and before the cut";
     }
-    start_asked_.store(true);
     return "";
+  }
+  if (request.kind == RequestKind::Stop) {
+    // Before the cut, a stop ends the wait for the start (the run ends, nothing cut); it also goes to
+    // the cycle's ring as ever, for a cycle that would run after all.
+    std::uint8_t awaiting = kAwaiting;
+    static_cast<void>(start_wait_.compare_exchange_strong(awaiting, kStopped));
   }
   Figures now{};
   const bool read = own_view_.read(now);

@@ -54,10 +54,14 @@ class DisplayLink final : public control::DisplayFeed {
   [[nodiscard]] control::CommandRing& commands() override { return commands_; }
 
   [[nodiscard]] RequestCounters counters() const;
-  // The spindle's start, through the link as from the terminal: while awaited, one Start request is
-  // accepted and taken here (true once); otherwise a Start is refused.
-  void await_start(bool awaiting) { awaiting_start_.store(awaiting); }
-  [[nodiscard]] bool take_start() { return start_asked_.exchange(false); }
+  // The spindle's start, through the link as from the terminal. While the program awaits it, one
+  // Start request is accepted (otherwise a Start is refused), and a Stop ends the wait with nothing
+  // cut. The program looks with start_answer() and ends the wait with end_start_wait(), which says
+  // what came first: a Start or a Stop taken at that very moment still counts, and is never lost.
+  enum class StartAnswer : std::uint8_t { None, Start, Stop };
+  void await_start() { start_wait_.store(kAwaiting); }
+  [[nodiscard]] StartAnswer start_answer() const { return answer_of(start_wait_.load()); }
+  StartAnswer end_start_wait() { return answer_of(start_wait_.exchange(kIdle)); }
   [[nodiscard]] const std::string& socket_path() const { return options_.socket_path; }
   [[nodiscard]] int feed_fd() const { return feed_.fd(); }
 
@@ -82,7 +86,13 @@ class DisplayLink final : public control::DisplayFeed {
   FeedView own_view_;  // the reset rule reads the newest telemetry back from the feed: no lock
   control::CommandRing commands_;  // the server thread pushes, the cycle pops; outlives both
   std::unique_ptr<RequestServer> server_;
-  std::atomic<bool> awaiting_start_{false}, start_asked_{false};  // the program's and the server thread's
+  // The start's wait, shared by the program's thread and the server's: Idle -> Awaiting (the program)
+  // -> Started or Stopped (the server, once) -> Idle (the program).
+  static constexpr std::uint8_t kIdle = 0, kAwaiting = 1, kStarted = 2, kStopped = 3;
+  static StartAnswer answer_of(std::uint8_t state) {
+    return state == kStarted ? StartAnswer::Start : state == kStopped ? StartAnswer::Stop : StartAnswer::None;
+  }
+  std::atomic<std::uint8_t> start_wait_{kIdle};
 };
 
 }  // namespace stencil::display_link

@@ -37,8 +37,8 @@ enum class MessageKind : std::uint8_t {
   Stop = 4,      // display -> controller: never rate-limited
   Pause = 5,     // display -> controller: feed hold
   Resume = 6,    // display -> controller
-  Start = 7,     // display or `stencil-rig start` -> controller: the spindle on, once homed (the
-                 // terminal's 'start'); refused unless the program is waiting for it
+  Start = 7,     // `stencil-rig start` (or any client of the link) -> controller: the spindle on, once
+                 // homed (the terminal's 'start'); refused unless the program is waiting for it
   Welcome = 16,  // controller -> display, with the feed's descriptor
   Accepted = 17,
   Refused = 18,  // reason: why

@@ -40,6 +40,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
     return result;
   }
   std::size_t offset = kFileHeaderBytes;
+  RecordType previous = RecordType::End;  // none yet
   while (offset < size) {
     const std::size_t left = size - offset;
     ByteReader head(data + offset, left);
@@ -299,6 +300,11 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         break;
       }
       case RecordType::Provenance: {
+        if (previous != RecordType::Start && previous != RecordType::Resume) {
+          result.error = at(offset) + "a provenance record not right after a start or resume record (it says what "
+                                      "made that run, once)";
+          return result;
+        }
         const std::uint16_t text = body.u16();
         if (version < kProvenanceVersion || body.overrun() || body.left() != text || text > kMaxProvenanceBytes) {
           result.error = at(offset) + "a provenance record of " + std::to_string(length) + " bytes" +
@@ -318,6 +324,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         return result;
     }
     ++result.records;
+    previous = type;
     offset += kRecordOverheadBytes + length;
   }
   result.good_bytes = offset;

@@ -90,13 +90,21 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
     return fail("cannot read its header", errno);
   }
   ByteReader version_bytes(header + sizeof kMagic, 4);
-  // Version 3 differs only in having no Provenance records: carried on without them, it stays one.
+  // Version 3's records are all version 4's (4 adds the Provenance record): such a journal is carried
+  // on as version 4, its header's version rewritten first. Anything older is not.
+  constexpr std::uint32_t kOldestCarriedOn = kProvenanceVersion - 1;
   const std::uint32_t version = version_bytes.u32();
-  if (version != kVersion && version + 1 != kProvenanceVersion) {
+  if (version < kOldestCarriedOn || version > kVersion) {
     return fail("is a version " + std::to_string(version) + " journal; this program carries on versions " +
-                    std::to_string(kProvenanceVersion - 1) + " and " + std::to_string(kVersion) +
-                    " only (start the job afresh)",
+                    std::to_string(kOldestCarriedOn) + " to " + std::to_string(kVersion) + " only (start the job afresh)",
                 0);
+  }
+  if (version != kVersion) {
+    ByteWriter now;
+    now.u32(kVersion);
+    if (::pwrite(fd_, now.data(), now.size(), sizeof kMagic) != static_cast<ssize_t>(now.size())) {
+      return fail("cannot have its header's version brought to " + std::to_string(kVersion), errno);
+    }
   }
   if (::ftruncate(fd_, static_cast<off_t>(good_bytes)) != 0) {
     return fail("cannot be cut to its " + std::to_string(good_bytes) + " whole bytes", errno);
@@ -113,9 +121,7 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
   add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
-  if (version >= kProvenanceVersion) {
-    add_provenance(resume.provenance);
-  }
+  add_provenance(resume.provenance);
   const bool synced = sync_locked(lock);
   accepting_.store(synced);
   return synced;

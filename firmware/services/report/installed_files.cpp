@@ -6,12 +6,19 @@
 #ifndef STENCIL_INSTALL_DATADIR
 #define STENCIL_INSTALL_DATADIR "share"
 #endif
+#ifndef STENCIL_INSTALL_FULL_DATADIR
+#define STENCIL_INSTALL_FULL_DATADIR "/usr/share"
+#endif
 
 namespace stencil::report {
 
 std::string shipped_path(const std::string& installed, const std::string& in_build) {
   std::error_code ec;
-  const std::filesystem::path prefix = std::filesystem::read_symlink("/proc/self/exe", ec).parent_path().parent_path();
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (ec || !self.is_absolute()) {  // no /proc: the package's place, never the current folder
+    return (std::filesystem::path(STENCIL_INSTALL_FULL_DATADIR) / "stencil" / installed).string();
+  }
+  const std::filesystem::path prefix = self.parent_path().parent_path();
   const std::filesystem::path shipped = prefix / STENCIL_INSTALL_DATADIR / "stencil" / installed;
   if (std::filesystem::exists(shipped, ec)) {
     return shipped.string();

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 
+#include "firmware/services/journal/journal_format.hpp"
 #include "firmware/services/report/build_version.hpp"
 
 namespace stencil::report {
@@ -13,7 +14,14 @@ std::string hex32(std::uint32_t value) {
   return text;
 }
 
-std::string quoted(const std::string& argument) {
+// One line whatever an argument holds: a control character (a newline, say) shows as '?'.
+std::string quoted(const std::string& raw) {
+  std::string argument = raw;
+  for (char& c : argument) {
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      c = '?';
+    }
+  }
   if (!argument.empty() && argument.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
                                                       "-_./=:,+@%") == std::string::npos) {
     return argument;
@@ -61,13 +69,23 @@ nlohmann::json provenance_json(const Provenance& p) {
 std::string provenance_line(const Provenance& p) {
   std::string line = p.program + " " + source_version() + " (" + build_compiler() + "); configuration " +
                      (p.configuration.empty() ? std::string("compiled-in")
-                                              : p.configuration + " crc32=" + hex32(p.configuration_crc32)) +
-                     "; tables " + p.tables + " crc32=" + hex32(p.tables_crc32) +
-                     " triangles=" + std::to_string(p.triangle_count) + "; command: " + shell_line(p.command_line);
-  constexpr std::size_t kMost = 4000;
-  if (line.size() > kMost) {
-    line.resize(kMost - 3);
-    line += "...";
+                                              : quoted(p.configuration) + " crc32=" + hex32(p.configuration_crc32)) +
+                     "; tables " + quoted(p.tables) + " crc32=" + hex32(p.tables_crc32) +
+                     " triangles=" + std::to_string(p.triangle_count) + "; command:";
+  // Whole arguments only, so what is there is still what a shell would split; " ..." says more was.
+  constexpr std::size_t kMost = journal::kMaxProvenanceBytes;
+  constexpr std::size_t kMore = 4;  // " ..."
+  for (const std::string& argument : p.command_line) {
+    const std::string word = quoted(argument);
+    if (line.size() + 1 + word.size() + kMore > kMost) {
+      line += " ...";
+      break;
+    }
+    line.push_back(' ');
+    line.append(word);
+  }
+  if (line.size() > kMost) {  // a program name or paths beyond any reason
+    line.resize(kMost);
   }
   return line;
 }

@@ -28,8 +28,9 @@ struct Provenance {
 // {path, crc32} or "compiled-in", tables {path, crc32, triangles}.
 [[nodiscard]] nlohmann::json provenance_json(const Provenance& provenance);
 
-// The same as one line of text for the journal (at most 4000 bytes: a long command line is cut with
-// "..." at its end), e.g. "stencil-sim v0.3-12-gabc1234 (GNU 12.2.0); configuration compiled-in;
+// The same as one line of text for the journal (at most journal::kMaxProvenanceBytes: a long command
+// line is cut after a whole argument, " ..." at its end; paths and arguments quoted as a shell would
+// need, a control character shown as '?'), e.g. "stencil-sim v0.3-12-gabc1234 (GNU 12.2.0); configuration compiled-in;
 // tables part.stbl crc32=1a2b3c4d triangles=24; command: stencil-sim --fast".
 [[nodiscard]] std::string provenance_line(const Provenance& provenance);
 
