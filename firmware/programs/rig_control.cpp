@@ -109,7 +109,7 @@ int run_control(const std::string& verb, const ControlOptions& options) {
       kind = v.kind;
     }
   }
-  ControllerClient client(options.socket_path);
+  ControllerClient client(options.socket_path, /*control=*/true);
   std::vector<Message> answers;
   const auto start = std::chrono::steady_clock::now();
   while (client.state() != LinkState::Connected && client.state() != LinkState::Refused &&

@@ -63,6 +63,16 @@ TEST(MessageCodec, EveryBadFieldIsNamedByItsByte) {
   m = make_message(MessageKind::Reset, 1);
   m.parameter = 1;
   STRCMP_CONTAINS("byte 7: expected 0 outside a Set", decode_error(m).c_str());
+  m = make_message(MessageKind::Hello, 0);
+  m.parameter = kHelloControl;  // a control command's hello: good
+  {
+    Message out{};
+    std::string error;
+    Bytes good(m);
+    CHECK(DecodeResult::Ok == decode_request(good.data, kMessageBytes, out, error));
+  }
+  m.parameter = 2;
+  STRCMP_CONTAINS("byte 7: who says hello: expected 0 (a display) or 1 (a control command)", decode_error(m).c_str());
   m = make_set(Parameter::Coupling, 1.0, 1);
   m.reserved = 1;
   STRCMP_CONTAINS("byte 12: reserved", decode_error(m).c_str());

@@ -216,6 +216,45 @@ TEST(RequestServer, AStopIsNeverRateLimitedAndStopPauseAndResumeReachTheRingAsTh
   close(feed);
 }
 
+// A control command's client (stencil-rig stop, ...) says so in its Hello: its commands are recorded as
+// from `control`, a display's beside it as from `display`.
+TEST(RequestServer, AControlCommandsRequestsAreRecordedAsFromControl) {
+  Folder folder;
+  const int feed = memfd_create("feed", MFD_CLOEXEC);
+  control::CommandRing ring;
+  RequestServer server({folder.socket(), 8, 10.0, 5.0}, feed, limits_refusal, ring);
+  std::string error;
+  CHECK(server.start(error));
+  const int command_fd = connect_to(folder.socket());
+  Message hello = make_message(MessageKind::Hello, 0);
+  hello.parameter = kHelloControl;
+  send_message(command_fd, hello);
+  Message answer{};
+  int passed = -1;
+  CHECK(receive(command_fd, answer, &passed));
+  close(passed);
+  send_message(command_fd, make_message(MessageKind::Pause, 1));
+  CHECK(receive(command_fd, answer));
+  CHECK(static_cast<MessageKind>(answer.kind) == MessageKind::Accepted);
+  const int display_fd = connect_to(folder.socket());
+  send_message(display_fd, make_message(MessageKind::Hello, 0));
+  CHECK(receive(display_fd, answer, &passed));
+  close(passed);
+  send_message(display_fd, make_message(MessageKind::Resume, 2));
+  CHECK(receive(display_fd, answer));
+  control::Command command{};
+  CHECK(ring.pop(command));
+  CHECK(command.kind == control::CommandKind::Pause);
+  CHECK(command.source == control::CommandSource::Control);
+  CHECK(ring.pop(command));
+  CHECK(command.kind == control::CommandKind::Resume);
+  CHECK(command.source == control::CommandSource::Display);
+  close(command_fd);
+  close(display_fd);
+  server.stop();
+  close(feed);
+}
+
 TEST(RequestServer, ADisplaySendingTooFastIsRefusedPastItsBurst) {
   Folder folder;
   const int feed = memfd_create("feed", MFD_CLOEXEC);

@@ -307,7 +307,7 @@ case_killing_the_display_changes_nothing() {
 }
 
 # A service has no terminal: `stencil-rig status|pause|start|stop` reach a running controller over
-# its socket, and a stop sent so ends its job in the safe state, recorded with the display's source.
+# its socket, and a stop sent so ends its job in the safe state, recorded with the source `control`.
 case_control_commands_reach_a_running_controller() {
   local socket="$PWD/control.sock" sim_pid
   "$sim" --speed 1 --pattern raster --duration 60 --display-socket "$socket" --journal job.journal \
@@ -339,7 +339,7 @@ case_control_commands_reach_a_running_controller() {
   status=$?
   sed 's/^/  stencil-sim: /' sim.log
   grep -q '"safe_state": "stopped"' report.json || fail "the job did not end in the safe state 'stopped'"
-  grep -q '"source": "display"' report.json || fail "the report does not record the stop's source"
+  grep -q '"source": "control"' report.json || fail "the report does not record the stop's source (control)"
   run_rig status --socket "$socket" --timeout 0.5
   expect_status 3
   expect_stderr "no controller at .*control.sock" "that no controller is there"

@@ -38,6 +38,7 @@ enum class CommandSource : std::uint8_t {
   Terminal,  // the rig's operator terminal
   Display,   // an operator display
   Replay,    // a replay of a journal, the safe state its record shows without a command
+  Control,   // a control command over the controller's socket (stencil-rig stop, reset, ...)
 };
 
 [[nodiscard]] constexpr const char* command_source_name(CommandSource source) {
@@ -56,10 +57,12 @@ enum class CommandSource : std::uint8_t {
       return "display";
     case CommandSource::Replay:
       return "replay";
+    case CommandSource::Control:
+      return "control";
   }
   return "unknown";
 }
-inline constexpr std::uint8_t kCommandSourceCount = 7;
+inline constexpr std::uint8_t kCommandSourceCount = 8;
 
 struct Command {
   CommandKind kind;

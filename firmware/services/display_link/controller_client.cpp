@@ -31,7 +31,7 @@ const char* link_state_name(LinkState state) {
   return "waiting";
 }
 
-ControllerClient::ControllerClient(std::string socket_path) : path_(std::move(socket_path)) {
+ControllerClient::ControllerClient(std::string socket_path, bool control) : path_(std::move(socket_path)), control_(control) {
   detail_ = "no controller at " + path_ + " yet: waiting for one";
 }
 
@@ -75,7 +75,8 @@ void ControllerClient::try_connect() {
     }
     return;
   }
-  const Message hello = make_message(MessageKind::Hello, 0);
+  Message hello = make_message(MessageKind::Hello, 0);
+  hello.parameter = control_ ? kHelloControl : kHelloDisplay;
   if (::send(fd_, &hello, kMessageBytes, MSG_NOSIGNAL | MSG_DONTWAIT) != static_cast<ssize_t>(kMessageBytes)) {
     drop(state_, detail_);
   }

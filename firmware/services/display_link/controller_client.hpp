@@ -23,7 +23,9 @@ enum class LinkState : std::uint8_t {
 
 class ControllerClient {
  public:
-  explicit ControllerClient(std::string socket_path);
+  // `control`: a control command's client (stencil-rig stop, ...), whose requests the controller
+  // records as from `control`; else a display.
+  explicit ControllerClient(std::string socket_path, bool control = false);
   ~ControllerClient();
   ControllerClient(const ControllerClient&) = delete;
   ControllerClient& operator=(const ControllerClient&) = delete;
@@ -49,6 +51,7 @@ class ControllerClient {
   bool take(std::vector<Message>& answers);
 
   std::string path_;
+  bool control_ = false;
   int fd_ = -1;
   bool welcomed_ = false;
   LinkState state_ = LinkState::Waiting;

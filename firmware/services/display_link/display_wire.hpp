@@ -29,9 +29,12 @@ inline constexpr std::uint16_t kProtocolVersion = 3;
 
 inline constexpr std::uint32_t kMessageMagic = 0x4B4C4453;  // "SDLK" on the wire (little-endian)
 inline constexpr std::size_t kReasonBytes = 160;
+inline constexpr std::uint8_t kHelloDisplay = 0;
+inline constexpr std::uint8_t kHelloControl = 1;
 
 enum class MessageKind : std::uint8_t {
-  Hello = 1,     // display -> controller, first
+  Hello = 1,     // display -> controller, first; its parameter says who: 0 a display, 1 a control
+                 // command (stencil-rig stop, ...), whose requests are recorded as from `control`
   Set = 2,       // display -> controller: parameter, value
   Reset = 3,     // display -> controller
   Stop = 4,      // display -> controller: never rate-limited
@@ -49,7 +52,7 @@ struct Message {
   std::uint32_t magic;
   std::uint16_t version;
   std::uint8_t kind;       // MessageKind
-  std::uint8_t parameter;  // Set: Parameter; else 0
+  std::uint8_t parameter;  // Set: Parameter; Hello: 0 a display, 1 a control command; else 0
   std::uint32_t id;        // the display's request number, echoed in the answer
   std::uint32_t reserved;  // 0
   double value;            // Set: the value asked; else 0

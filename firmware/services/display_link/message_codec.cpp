@@ -48,10 +48,13 @@ DecodeResult decode_message(const unsigned char* bytes, std::size_t size, Messag
     return DecodeResult::Malformed;
   }
   const auto kind = static_cast<MessageKind>(message.kind);
-  if (kind == MessageKind::Set ? message.parameter >= kParameterCount : message.parameter != 0) {
-    error = at(offsetof(Message, parameter), kind == MessageKind::Set
-                                                 ? "unknown parameter " + std::to_string(message.parameter) + " (0 to 2)"
-                                                 : "expected 0 outside a Set");
+  const std::uint8_t most = kind == MessageKind::Set     ? kParameterCount - 1
+                            : kind == MessageKind::Hello ? kHelloControl
+                                                         : 0;
+  if (message.parameter > most) {
+    error = at(offsetof(Message, parameter), kind == MessageKind::Set     ? "unknown parameter " + std::to_string(message.parameter) + " (0 to 2)"
+                                             : kind == MessageKind::Hello ? "who says hello: expected 0 (a display) or 1 (a control command)"
+                                                                          : "expected 0 outside a Set and a Hello");
     return DecodeResult::Malformed;
   }
   if (message.reserved != 0) {

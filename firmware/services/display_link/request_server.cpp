@@ -37,6 +37,7 @@ bool fill_address(const std::string& path, sockaddr_un& address, std::string& er
 struct RequestServer::Peer {
   int fd = -1;
   bool welcomed = false;
+  bool control = false;  // a control command's client (its Hello said so): its commands' source
   unsigned char buffer[kMessageBytes] = {};
   std::size_t filled = 0;
   double tokens = 0.0;
@@ -216,6 +217,7 @@ bool RequestServer::read_peer(Peer& peer) {
     }
     if (static_cast<MessageKind>(message.kind) == MessageKind::Hello) {
       peer.welcomed = true;
+      peer.control = message.parameter == kHelloControl;
       if (!answer(peer, make_message(MessageKind::Welcome, message.id), true)) {
         return false;
       }
@@ -246,6 +248,10 @@ void RequestServer::handle(Peer& peer, const Message& message) {
   } else {
     peer.tokens = std::max(0.0, peer.tokens - 1.0);
     refusal = decide_ ? decide_(request) : std::string();
+    control::Command command = command_of(request);
+    if (peer.control) {
+      command.source = control::CommandSource::Control;
+    }
     // Straight into the cycle's ring: the next cycle takes it (this thread is the ring's one producer).
     // The last slot is kept for a stop; a stop pressed again within 100 ms of one already sent is the
     // same stop (accepted, not sent twice), so a held-down key fills neither the ring nor the record.
@@ -257,7 +263,7 @@ void RequestServer::handle(Peer& peer, const Message& message) {
     } else if (refusal.empty()) {
       const bool room = stop ? commands_.size() < control::CommandRing::capacity()
                              : commands_.size() + 1 < control::CommandRing::capacity();
-      if (!room || !commands_.push(command_of(request))) {
+      if (!room || !commands_.push(command)) {
         refusal = "too many requests waiting for the cycle; try again";
       } else if (stop) {
         last_stop_s_ = now;

@@ -30,7 +30,7 @@ const reportPath = path.join(workDir, 'report.json');
 
 const UPDATE_NS = 1e9 / 30;  // the machine update (rig_facts.hpp)
 const KIND = ['reset', 'stop', 'journal_failed', 'set_coupling', 'set_force_limit', 'set_speed_limit', 'pause', 'resume'];
-const SOURCE = ['cycle', 'machine', 'program', 'signal', 'terminal', 'display', 'replay'];
+const SOURCE = ['cycle', 'machine', 'program', 'signal', 'terminal', 'display', 'replay', 'control'];
 
 function fail(message) {
   console.error(`FAIL: ${message}`);

@@ -1,0 +1,134 @@
+// The comparisons stencil-same-behaviour makes: two journals of the same job are the same apart from
+// their start times and their Provenance records (which build, which command line), whichever side
+// has them (version 3 against version 4); a real difference after a Provenance record is still found
+// and placed. Two reports are the same apart from the wall clock and their provenance.
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include <unistd.h>
+
+#include <nlohmann/json.hpp>
+
+#include "firmware/services/journal/journal_writer.hpp"
+#include "toolchain/same_behaviour/journal_comparison.hpp"
+#include "toolchain/same_behaviour/report_comparison.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+
+namespace {
+
+struct TempFile {
+  std::string path;
+  TempFile() {
+    char name[] = "/tmp/same_behaviour_tests_XXXXXX";
+    const int fd = mkstemp(name);
+    if (fd >= 0) {
+      close(fd);
+    }
+    path = name;
+  }
+  ~TempFile() { std::remove(path.c_str()); }
+};
+
+control::JournalRecord cycle_record(std::uint64_t cycle, double tip_x) {
+  control::JournalRecord r{};
+  r.cycle = cycle;
+  r.time_ns = static_cast<std::int64_t>(cycle) * 1'000'000;
+  r.virtual_tip_mm[0] = tip_x;
+  r.fresh = true;
+  return r;
+}
+
+// A job of 4 cycles; `provenance` "" writes none; `start_ns` the wall clock's start; cycle 2's tool at `x2`.
+void write_job(const std::string& path, const std::string& provenance, std::int64_t start_ns, double x2 = 25.0) {
+  journal::JournalWriter writer;
+  journal::JournalStart start;
+  start.tables_crc32 = 0x1234;
+  start.triangle_count = 24;
+  start.unix_time_ns = start_ns;
+  start.program = "same_behaviour_tests";
+  start.job = "pattern=raster";
+  start.provenance = provenance;
+  CHECK_TRUE(writer.open(path, start));
+  for (std::uint64_t c = 0; c < 4; ++c) {
+    CHECK_TRUE(writer.append(cycle_record(c, c == 2 ? x2 : 25.0)));
+  }
+  CHECK_TRUE(writer.append_end(4, control::SafeReason::None));
+  CHECK_TRUE(writer.close());
+}
+
+// The file as a version 3 journal (no Provenance record was written into it).
+void mark_version_3(const std::string& path) {
+  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(8);
+  const char three[4] = {3, 0, 0, 0};
+  file.write(three, 4);
+}
+
+}  // namespace
+
+TEST_GROUP(SameBehaviour){};
+
+TEST(SameBehaviour, JournalsOfTheSameJobAreTheSameWhateverBuildAndStartWroteThem) {
+  TempFile older, newer;
+  write_job(older.path, "stencil-sim abc123 (GNU 12); command: /old/build/bin/stencil-sim --fast", 1'000);
+  write_job(newer.path, "stencil-sim def456-dirty (GNU 12); command: /new/build/bin/stencil-sim --fast --report r.json", 2'000);
+  const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
+  STRCMP_EQUAL("", result.error.c_str());
+  CHECK_EQUAL(0U, result.differences.size());
+  CHECK_EQUAL(1U, result.start_times);
+  CHECK_EQUAL(2U, result.provenance);
+  CHECK_EQUAL(6U, result.records);  // start, 4 cycles, end: the provenance left out
+}
+
+TEST(SameBehaviour, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One) {
+  TempFile older, newer;
+  write_job(older.path, "", 1'000);
+  mark_version_3(older.path);
+  write_job(newer.path, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000);
+  const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
+  STRCMP_EQUAL("", result.error.c_str());
+  CHECK_EQUAL(0U, result.differences.size());
+  CHECK_EQUAL(1U, result.provenance);
+}
+
+TEST(SameBehaviour, ADifferenceAfterAProvenanceRecordIsFoundAndPlaced) {
+  TempFile older, newer;
+  write_job(older.path, "", 1'000);
+  mark_version_3(older.path);
+  write_job(newer.path, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000, 25.001);
+  const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
+  STRCMP_EQUAL("", result.error.c_str());
+  CHECK_EQUAL(1U, result.differences.size());
+  STRCMP_CONTAINS("record 3 (cycle 2)", result.differences[0].c_str());  // start, cycles 0, 1, 2
+  STRCMP_CONTAINS("its payload from byte", result.differences[0].c_str());
+  // Another version step than 3 to 4 is a difference of its own.
+  std::fstream file(older.path, std::ios::in | std::ios::out | std::ios::binary);
+  file.seekp(8);
+  const char two[4] = {2, 0, 0, 0};
+  file.write(two, 4);
+  file.close();
+  write_job(newer.path, "x", 2'000);
+  const same_behaviour::JournalComparison versions = same_behaviour::compare_journals(older.path, newer.path);
+  CHECK(versions.differences.size() >= 1U);
+  STRCMP_CONTAINS("the file versions differ: 2 and 4", versions.differences[0].c_str());
+}
+
+TEST(SameBehaviour, ReportsLeaveOutTheWallClockAndTheProvenanceButNothingElse) {
+  const nlohmann::json older = {{"cycles", 100}, {"wall_s", 3.5},
+                                {"provenance", {{"version", "abc"}, {"command_line", {"/old/stencil-sim"}}}}};
+  nlohmann::json newer = {{"cycles", 100}, {"wall_s", 4.0},
+                          {"provenance", {{"version", "def"}, {"command_line", {"/new/stencil-sim", "--fast"}}}}};
+  same_behaviour::ReportComparison result = same_behaviour::compare_reports(older, newer);
+  CHECK_EQUAL(0U, result.changed.size());
+  CHECK_EQUAL(0U, result.added.size());
+  newer["cycles"] = 101;
+  result = same_behaviour::compare_reports(older, newer);
+  CHECK_EQUAL(1U, result.changed.size());
+  STRCMP_CONTAINS("cycles", result.changed[0].c_str());
+}
