@@ -44,24 +44,16 @@ work=$(cd "$work" && pwd)
 root=$work/root
 
 # Everything mounted under the root comes off again, however the script ends.
-unmount_root() {
-  for mount_point in "$root/dev" "$root/sys" "$root/proc"; do
-    if mountpoint -q "$mount_point" 2>/dev/null; then umount -R -l "$mount_point" || true; fi
-  done
-}
-trap unmount_root EXIT
-unmount_root
-rm -rf --one-file-system "$root"  # never into a bind mount left by a killed run
+source "$repo/toolchain/debian-root.sh"
+trap 'debian_root_unmount "$root"' EXIT
+debian_root_fresh "$root"
 
 # Debian 12 as a fresh install sees it: the release, its updates and its security archive. The apt
 # variant is Essential plus apt, as minimal as a container image: whatever else the commands need,
 # they must install themselves.
 echo "fresh-check: a clean Debian 12 root in $root (mmdebstrap)"
 start=$(date +%s)
-mmdebstrap --quiet --variant=apt --include=git,make bookworm "$root" \
-  "deb http://deb.debian.org/debian bookworm main" \
-  "deb http://deb.debian.org/debian bookworm-updates main" \
-  "deb http://deb.debian.org/debian-security bookworm-security main"
+debian_root_make "$root" --variant=apt --include=git,make
 echo "fresh-check: root made in $(( $(date +%s) - start )) s"
 
 # This host's extra certificate authorities (a TLS-inspecting proxy here): a user's machine has its
@@ -78,9 +70,7 @@ git -C "$root/root/stencil" checkout --quiet "$commit"
 
 # The tests use pseudo-terminals, memfds, SCHED_FIFO, a tmpfs mount and Chromium: the host's /dev,
 # /proc and /sys, as on a machine of its own.
-mount -t proc proc "$root/proc"
-mount --rbind /sys "$root/sys" && mount --make-rslave "$root/sys"
-mount --rbind /dev "$root/dev" && mount --make-rslave "$root/dev"
+debian_root_mount "$root"
 
 # run_in_root NAME COMMAND: runs COMMAND in the clone as root with a login's plain environment,
 # logs to WORK_DIR/NAME.log, prints its result and time; the status is kept in the global `failed`.
@@ -116,7 +106,7 @@ printf 'fresh-check: %s\n' "${summary[@]}"
 grep -E '^(simulated|gouge|stock removed|coverage|safe state)' "$work/demo.log" | sed 's/^/fresh-check: demo: /' || true
 grep -E 'tests passed|tests failed' "$work/test.log" | sed 's/^/fresh-check: test: /' || true
 
-unmount_root
+debian_root_unmount "$root"
 if [ "$remove_root" -eq 1 ]; then rm -rf --one-file-system "$root"; fi
 if [ "${#failed[@]}" -ne 0 ]; then
   echo "fresh-check: FAILED: ${failed[*]}" >&2

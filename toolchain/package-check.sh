@@ -38,14 +38,9 @@ work=$(cd "$work" && pwd)
 deb=$(cd "$(dirname "$deb")" && pwd)/$(basename "$deb")
 root=$work/root
 
-unmount_root() {
-  for mount_point in "$root/dev" "$root/sys" "$root/proc"; do
-    if mountpoint -q "$mount_point" 2>/dev/null; then umount -R -l "$mount_point" || true; fi
-  done
-}
-trap unmount_root EXIT
-unmount_root
-rm -rf --one-file-system "$root"
+source "$(dirname "$0")/debian-root.sh"
+trap 'debian_root_unmount "$root"' EXIT
+debian_root_fresh "$root"
 
 failures=0
 fail() { echo "package-check: FAIL: $*" >&2; failures=$((failures + 1)); }
@@ -55,15 +50,10 @@ as_user() { chroot "$root" /usr/bin/env -i LANG=C.UTF-8 PATH=/usr/bin:/bin su - 
 
 step "a clean Debian 12 root in $root (mmdebstrap --variant=important)"
 started=$(date +%s)
-mmdebstrap --quiet --variant=important bookworm "$root" \
-  "deb http://deb.debian.org/debian bookworm main" \
-  "deb http://deb.debian.org/debian bookworm-updates main" \
-  "deb http://deb.debian.org/debian-security bookworm-security main"
+debian_root_make "$root" --variant=important
 echo "root made in $(( $(date +%s) - started )) s"
 cp -L /etc/resolv.conf "$root/etc/resolv.conf"
-mount -t proc proc "$root/proc"
-mount --rbind /sys "$root/sys" && mount --make-rslave "$root/sys"
-mount --rbind /dev "$root/dev" && mount --make-rslave "$root/dev"
+debian_root_mount "$root"
 
 step "install $(basename "$deb") with apt ($(du -h "$deb" | cut -f1) on disk)"
 cp "$deb" "$root/tmp/"
@@ -150,7 +140,7 @@ if [ -n "$(cd "$root" && find ./var/lib/stencil ! -user root 2>/dev/null)" ]; th
   fail "files in /var/lib/stencil still belong to the removed user"
 fi
 
-unmount_root
+debian_root_unmount "$root"
 if [ "$remove_root" -eq 1 ]; then rm -rf --one-file-system "$root"; fi
 echo
 if [ "$failures" -ne 0 ]; then echo "package-check: $failures failure(s)" >&2; exit 1; fi

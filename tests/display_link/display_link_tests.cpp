@@ -71,6 +71,19 @@ std::vector<Message> poll_until(ControllerClient& client, Done done) {
   return answers;
 }
 
+// A controller's link, started, with a display connected to it.
+struct Connected {
+  Prism prism;
+  Folder folder;
+  DisplayLink link{prism.part, config(), {folder.socket(), "stencil-test", false}};
+  ControllerClient client{folder.socket()};
+  Connected() {
+    std::string error;
+    CHECK_TRUE_TEXT(link.start(error), error.c_str());
+    poll_until(client, [&](const auto&) { return client.state() == LinkState::Connected; });
+  }
+};
+
 }  // namespace
 
 TEST_GROUP(DisplayLink) {
@@ -127,13 +140,9 @@ TEST(DisplayLink, ADisplayWaitsForItsControllerThenSeesItsState) {
 }
 
 TEST(DisplayLink, RequestsAreDecidedOnTheControllersSideAndAcceptedOnesReachTheCycle) {
-  Prism prism;
-  Folder folder;
-  DisplayLink link(prism.part, config(), {folder.socket(), "stencil-test", false});
-  std::string error;
-  CHECK(link.start(error));
-  ControllerClient client(folder.socket());
-  poll_until(client, [&](const auto&) { return client.state() == LinkState::Connected; });
+  Connected connected;
+  DisplayLink& link = connected.link;
+  ControllerClient& client = connected.client;
   // A reset outside the safe state: refused with the reason; then in one, with the handle still and
   // near: accepted, and the cycle's command is waiting.
   CHECK(client.send(make_message(MessageKind::Reset, 1)));
@@ -165,13 +174,9 @@ TEST(DisplayLink, RequestsAreDecidedOnTheControllersSideAndAcceptedOnesReachTheC
 // The spindle's start through the link (a service has no terminal): refused unless the program is
 // waiting for it, then taken once by the program, never as a cycle command; a stop ends the wait.
 TEST(DisplayLink, AStartIsTakenOnceByTheWaitingProgramAndAStopEndsTheWait) {
-  Prism prism;
-  Folder folder;
-  DisplayLink link(prism.part, config(), {folder.socket(), "stencil-test", false});
-  std::string error;
-  CHECK(link.start(error));
-  ControllerClient client(folder.socket());
-  poll_until(client, [&](const auto&) { return client.state() == LinkState::Connected; });
+  Connected connected;
+  DisplayLink& link = connected.link;
+  ControllerClient& client = connected.client;
   CHECK(client.send(make_message(MessageKind::Start, 1)));
   std::vector<Message> answers = poll_until(client, [](const auto& a) { return !a.empty(); });
   CHECK_EQUAL(1U, answers.size());

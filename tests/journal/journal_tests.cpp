@@ -603,7 +603,8 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion4) {
   }
   bytes = file.bytes();
   const std::size_t start_record = kFileHeaderBytes;
-  const std::size_t provenance_at = start_record + kRecordOverheadBytes + (bytes[start_record] | (bytes[start_record + 1] << 8));
+  const std::size_t start_length = bytes[start_record] + (std::size_t{bytes[start_record + 1]} << 8U);
+  const std::size_t provenance_at = start_record + kRecordOverheadBytes + start_length;
   const std::size_t provenance_length = kRecordOverheadBytes + 2 + 7;
   CHECK_EQUAL(static_cast<int>(RecordType::Provenance), bytes[provenance_at + 4]);
   std::vector<std::uint8_t> twice(bytes.begin(), bytes.begin() + static_cast<long>(provenance_at + provenance_length));
