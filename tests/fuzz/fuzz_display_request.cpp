@@ -29,12 +29,18 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     require(length == kMessageBytes && message.magic == kMessageMagic && message.version == kProtocolVersion);
     const auto kind = static_cast<MessageKind>(message.kind);
     require(kind == MessageKind::Hello || kind == MessageKind::Set || kind == MessageKind::Reset || kind == MessageKind::Stop ||
-            kind == MessageKind::Pause || kind == MessageKind::Resume);
+            kind == MessageKind::Pause || kind == MessageKind::Resume || kind == MessageKind::Start);
     require(std::isfinite(message.value));
     if (kind == MessageKind::Hello) {
+      require(message.parameter == kHelloDisplay || message.parameter == kHelloControl);  // who is speaking
       continue;
     }
     const Request request = request_of(message);
+    if (kind == MessageKind::Start) {
+      // Never a cycle command: the server hands it to the program waiting for the spindle's start.
+      require(request.kind == RequestKind::Start && message.parameter == 0);
+      continue;
+    }
     const RequestLimits limits;
     const std::string refused = refusal(request, limits);
     const stencil::control::Command command = command_of(request);
