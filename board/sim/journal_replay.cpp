@@ -10,10 +10,11 @@ bool JournalReplay::before_cycle(const runtime::CycleTime& /*time*/) {
     return false;  // the record ends here, and so does the replay
   }
   recorded_ = &records_[cycles_];
-  device_.set(*recorded_);
+  const control::JournalRecord& recorded = recorded_->record;
+  device_.set(recorded);
   // The commands this cycle took, as they came (a command taken before the first record: at once).
   bool stopped = false;
-  for (; next_taken_ < taken_.size() && taken_[next_taken_].cycle <= recorded_->cycle; ++next_taken_) {
+  for (; next_taken_ < taken_.size() && taken_[next_taken_].cycle <= recorded.cycle; ++next_taken_) {
     const control::CommandEvent& event = taken_[next_taken_];
     stopped = stopped || event.kind == control::CommandKind::Stop || event.kind == control::CommandKind::JournalFailed;
     if (!commands_.push({event.kind, event.asked, event.source})) {
@@ -22,8 +23,8 @@ bool JournalReplay::before_cycle(const runtime::CycleTime& /*time*/) {
   }
   // A safe state the device's read and the commands do not explain (the machine's fault, a stalled
   // host, a journal without command records): the record says it came, so it comes here too.
-  if (!stopped && recorded_->safe_reason != control::SafeReason::None &&
-      controller_.safe_reason() == control::SafeReason::None && !control::is_device_reason(recorded_->safe_reason)) {
+  if (!stopped && recorded.safe_reason != control::SafeReason::None &&
+      controller_.safe_reason() == control::SafeReason::None && !control::is_device_reason(recorded.safe_reason)) {
     static_cast<void>(commands_.push({control::CommandKind::Stop, 0.0, control::CommandSource::Replay}));
   }
   return true;
@@ -32,13 +33,16 @@ bool JournalReplay::before_cycle(const runtime::CycleTime& /*time*/) {
 void JournalReplay::after_cycle(const runtime::CycleTime& /*time*/, control::CycleStatus /*status*/) {
   ++cycles_;
   const Eigen::Vector3d tip = controller_.virtual_tip_mm();
-  if (tip.x() != recorded_->virtual_tip_mm[0] || tip.y() != recorded_->virtual_tip_mm[1] ||
-      tip.z() != recorded_->virtual_tip_mm[2]) {
-    if (mismatches_++ == 0) {
-      first_mismatch_ = static_cast<std::int64_t>(recorded_->cycle);
-    }
+  const control::JournalRecord& recorded = recorded_->record;
+  const double replayed[3] = {tip.x(), tip.y(), tip.z()};
+  const bool same = recorded_->tool_recorded
+                        ? tip.x() == recorded.virtual_tip_mm[0] && tip.y() == recorded.virtual_tip_mm[1] &&
+                              tip.z() == recorded.virtual_tip_mm[2]
+                        : journal::tip_check(replayed) == recorded_->tip_check;
+  if (!same && mismatches_++ == 0) {
+    first_mismatch_ = static_cast<std::int64_t>(recorded.cycle);
   }
-  recorded_reason_ = recorded_->safe_reason;
+  recorded_reason_ = recorded.safe_reason;
 }
 
 }  // namespace stencil::board::sim

@@ -1,7 +1,9 @@
 // JournalReplay: one recorded run of a journal replayed (stencil-sim --replay): before each cycle the
 // device gives exactly what the recorded cycle read and the cycle's command ring holds the commands
 // the recorded cycle took (a stop, a reset, a pause, a parameter), and after it the virtual tool is
-// compared with the recorded one, bit for bit. The run ends with the records. A hook of the job's run, virtual
+// compared with the recorded one, bit for bit (or with its recorded CRC-32, where a compact journal
+// kept only that: a tool that differs anywhere in its 24 bytes is caught unless its CRC-32 collides,
+// about one in four billion). The run ends with the records. A hook of the job's run, virtual
 // time only.
 #pragma once
 
@@ -11,6 +13,7 @@
 #include "firmware/core/control/controller.hpp"
 #include "firmware/core/control/cycle_messages.hpp"
 #include "firmware/runtime/job_hooks.hpp"
+#include "firmware/services/journal/cycle_codec.hpp"
 #include "sim/haptic_device/replay_haptic_device.hpp"
 
 namespace stencil::board::sim {
@@ -19,7 +22,7 @@ class JournalReplay final : public runtime::JobHooks {
  public:
   // Everything must outlive the replay; `device` is what the cycle reads, `commands` its command
   // ring (this hook pushes on the cycle's thread, which in virtual time is the ring's one producer).
-  JournalReplay(const std::vector<control::JournalRecord>& records, const std::vector<control::CommandEvent>& taken,
+  JournalReplay(const std::vector<journal::RecordedCycle>& records, const std::vector<control::CommandEvent>& taken,
                 stencil::sim::ReplayHapticDevice& device, const control::Controller& controller,
                 control::CommandRing& commands)
       : records_(records), taken_(taken), device_(device), controller_(controller), commands_(commands) {}
@@ -37,13 +40,13 @@ class JournalReplay final : public runtime::JobHooks {
   [[nodiscard]] std::uint64_t commands_not_replayed() const { return commands_not_replayed_; }
 
  private:
-  const std::vector<control::JournalRecord>& records_;
+  const std::vector<journal::RecordedCycle>& records_;
   const std::vector<control::CommandEvent>& taken_;  // in order: the cycles that took them rise
   std::size_t next_taken_ = 0;
   stencil::sim::ReplayHapticDevice& device_;
   const control::Controller& controller_;
   control::CommandRing& commands_;
-  const control::JournalRecord* recorded_ = nullptr;  // this cycle's
+  const journal::RecordedCycle* recorded_ = nullptr;  // this cycle's
   std::uint64_t cycles_ = 0;
   std::uint64_t mismatches_ = 0;
   std::int64_t first_mismatch_ = -1;

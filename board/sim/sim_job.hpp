@@ -61,7 +61,7 @@ struct SimJob {
   // run_fast only: replay these recorded cycles (one run of a journal, in order) instead of the
   // operator and the device; each cycle reads exactly what the recorded one read. With resume_from
   // set to the runs before it, a resumed run is replayed from where it started.
-  const std::vector<control::JournalRecord>* replay = nullptr;
+  const std::vector<journal::RecordedCycle>* replay = nullptr;
   const std::vector<control::CommandEvent>* replay_commands = nullptr;  // the commands that run took (null: none)
   // run_fast only: at most this many simulated seconds per wall-clock second (0: as fast as it goes),
   // so a person can watch a deterministic run.

@@ -95,12 +95,12 @@ std::string picture_path_of(const std::string& report_path) {
 }
 
 // One run of a journal (0: the first, 1 the first resume, ...): its cycles and the commands they took.
-bool read_run(const std::string& path, std::uint32_t run, std::size_t good_bytes, std::vector<control::JournalRecord>& records,
+bool read_run(const std::string& path, std::uint32_t run, std::size_t good_bytes, std::vector<journal::RecordedCycle>& records,
               std::vector<control::CommandEvent>& commands, std::string& error) {
   std::uint32_t in_run = 0;
   journal::JournalVisitor keep;
   keep.resume = [&](const journal::JournalResume&) { ++in_run; };
-  keep.cycle = [&](const control::JournalRecord& r) {
+  keep.cycle = [&](const journal::RecordedCycle& r) {
     if (in_run == run) {
       records.push_back(r);
     }
@@ -162,7 +162,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
   bool all_same = true;
   const app::CpuLatencyHold latency_hold;
   for (std::uint32_t run = 0; run < history.segments; ++run) {
-    std::vector<control::JournalRecord> records;
+    std::vector<journal::RecordedCycle> records;
     std::vector<control::CommandEvent> commands;
     if (!read_run(path, run, history.good_bytes, records, commands, error)) {
       return bad_input("--replay: " + error);

@@ -55,8 +55,14 @@ int read_and_check(const std::uint8_t* data, std::size_t size) {
         require(start.program.size() <= 256 && start.job.size() <= 1024);
         ++visits;
       },
-      [&](const stencil::control::JournalRecord& r) {
+      [&](const stencil::journal::RecordedCycle& c) {
+        const stencil::control::JournalRecord& r = c.record;
         require(static_cast<int>(r.safe_reason) <= static_cast<int>(stencil::control::SafeReason::Stopped));
+        require(static_cast<int>(r.read_status) <= static_cast<int>(stencil::hal::ReadStatus::Fault));
+        require(static_cast<int>(r.read_reason) <= static_cast<int>(stencil::hal::HapticFault::HostWatchdogTripped));
+        // A tool not recorded is NaN, never a guess; a recorded one is what its check says.
+        require(c.tool_recorded || r.virtual_tip_mm[0] != r.virtual_tip_mm[0]);
+        require(!c.tool_recorded || stencil::journal::tip_check(r.virtual_tip_mm) == c.tip_check);
         ++visits;
       },
       [&](std::uint64_t, stencil::control::SafeReason reason) {

@@ -11,10 +11,12 @@
 #include <unistd.h>
 #include <zlib.h>
 
+#include "firmware/services/journal/journal_bytes.hpp"
 #include "firmware/services/journal/journal_drain.hpp"
 #include "firmware/services/journal/journal_format.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
+#include "tests/support/old_journal.hpp"
 
 #include <CppUTest/TestHarness.h>
 
@@ -46,8 +48,12 @@ JournalRecord record_of(std::uint64_t cycle, SafeReason reason = SafeReason::Non
   r.status_bits = 0x8001;
   r.read_status = cycle % 3 == 0 ? stencil::hal::ReadStatus::Rejected : stencil::hal::ReadStatus::Fresh;
   r.read_reason = cycle % 3 == 0 ? stencil::hal::HapticFault::SampleNotFinite : stencil::hal::HapticFault::None;
+  r.max_force_n = 4.8 + 1e-3 * static_cast<double>(cycle / 50);
+  r.max_offset_mm = 0.5;
   return r;
 }
+
+using stencil::testing::OldJournal;
 
 struct TempJournal {
   std::string path;
@@ -89,7 +95,7 @@ void write_job(const std::string& path, int cycles, int safe_from = -1) {
 
 struct Seen {
   int starts = 0;
-  std::vector<JournalRecord> cycles;
+  std::vector<RecordedCycle> cycles;
   std::vector<std::pair<std::uint64_t, SafeReason>> events;
   std::vector<std::int64_t> homings;
   std::vector<stencil::control::MachineCommandRecord> commands;
@@ -105,7 +111,7 @@ struct Seen {
       ++starts;
       start = s;
     };
-    v.cycle = [this](const JournalRecord& r) { cycles.push_back(r); };
+    v.cycle = [this](const RecordedCycle& r) { cycles.push_back(r); };
     v.safe_state = [this](std::uint64_t cycle, SafeReason reason) { events.emplace_back(cycle, reason); };
     v.safe_source = [this](std::uint64_t, SafeReason, stencil::control::CommandSource source) { sources.push_back(source); };
     v.command = [this](const stencil::control::CommandEvent& e) { taken.push_back(e); };
@@ -118,13 +124,18 @@ struct Seen {
   }
 };
 
-void check_same(const JournalRecord& a, const JournalRecord& b) {
+// `seen` is `a` as written: bit for bit (a replay must be exact), its tool whole or its check.
+void check_same(const JournalRecord& a, const RecordedCycle& seen) {
+  const JournalRecord& b = seen.record;
   LONGS_EQUAL(a.cycle, b.cycle);
   LONGS_EQUAL(a.time_ns, b.time_ns);
+  LONGS_EQUAL(tip_check(a.virtual_tip_mm), seen.tip_check);
   for (int i = 0; i < 3; ++i) {
-    CHECK(a.device_mm[i] == b.device_mm[i]);  // bit for bit: a replay must be exact
-    CHECK(a.virtual_tip_mm[i] == b.virtual_tip_mm[i]);
+    CHECK(a.device_mm[i] == b.device_mm[i]);
+    CHECK(!seen.tool_recorded || a.virtual_tip_mm[i] == b.virtual_tip_mm[i]);
+    CHECK(!seen.tool_recorded || a.force_n[i] == b.force_n[i]);
   }
+  CHECK(!seen.maxima_recorded || (a.max_force_n == b.max_force_n && a.max_offset_mm == b.max_offset_mm));
   CHECK(a.angles_rad[0] == b.angles_rad[0] && a.angles_rad[1] == b.angles_rad[1]);
   LONGS_EQUAL(a.sample_counter, b.sample_counter);
   CHECK(a.fresh == b.fresh);
@@ -132,9 +143,17 @@ void check_same(const JournalRecord& a, const JournalRecord& b) {
   LONGS_EQUAL(a.touched_triangles, b.touched_triangles);
   LONGS_EQUAL(a.status_bits, b.status_bits);
   CHECK(a.read_status == b.read_status && a.read_reason == b.read_reason);
-  for (int i = 0; i < 3; ++i) {
-    CHECK(a.force_n[i] == b.force_n[i]);
-  }
+}
+
+// Where each whole record starts, and where the last one ends.
+std::vector<std::size_t> record_starts(const std::vector<std::uint8_t>& bytes) {
+  std::vector<std::size_t> starts;
+  JournalVisitor offsets;
+  offsets.offset = [&](std::size_t offset) { starts.push_back(offset); };
+  const JournalReadResult read = read_journal(bytes.data(), bytes.size(), offsets);
+  CHECK_TEXT(read.ok, read.error.c_str());
+  starts.push_back(read.good_bytes);
+  return starts;
 }
 
 stencil::control::MachineCommandRecord command_of(std::uint64_t update) {
@@ -160,14 +179,23 @@ TEST(Journal, WhatIsWrittenReadsBackExactlyWithTheStartAndTheSafeStateEvent) {
   STRCMP_EQUAL("journal_tests", seen.start.program.c_str());
   STRCMP_EQUAL("pattern=raster seed=1", seen.start.job.c_str());
   LONGS_EQUAL(300, seen.cycles.size());
+  int tools = 0;
   for (int i = 0; i < 300; ++i) {
-    check_same(record_of(static_cast<std::uint64_t>(i), i >= 250 ? SafeReason::PoseJump : SafeReason::None),
-               seen.cycles[static_cast<std::size_t>(i)]);
+    const RecordedCycle& cycle = seen.cycles[static_cast<std::size_t>(i)];
+    check_same(record_of(static_cast<std::uint64_t>(i), i >= 250 ? SafeReason::PoseJump : SafeReason::None), cycle);
+    // The tool whole at the run's first cycle, wherever the touched set grew, and where the safe
+    // state came: the resume rebuilds the touched set from these.
+    const bool grew = i > 0 && i % 7 == 0;
+    CHECK_EQUAL(i == 0 || grew || i == 250, cycle.tool_recorded);
+    tools += cycle.tool_recorded ? 1 : 0;
+    CHECK_TRUE(cycle.maxima_recorded);
   }
+  LONGS_EQUAL(1 + 42 + 1, tools);  // the first, 42 growths (7 to 294), the safe state's (not a growth)
   LONGS_EQUAL(1, seen.events.size());  // one event, not one per cycle in the safe state
   LONGS_EQUAL(250, seen.events[0].first);
   CHECK(seen.events[0].second == SafeReason::PoseJump);
-  LONGS_EQUAL(1 + 300 + 1, read.records);
+  // Start; cycles 0-99, 100-199, 200-250 (ended by the event); the event; cycles 251-299.
+  LONGS_EQUAL(1 + 3 + 1 + 1, read.records);
 }
 
 TEST(Journal, TheSafeStateEventIsOnTheDiskTheMomentItIsAppended) {
@@ -204,51 +232,52 @@ TEST(Journal, SyncsWhenASecondHasPassedAndNotBefore) {
   LONGS_EQUAL(after_open + 2, writer.syncs());
 }
 
-// A crash can cut the file anywhere: every cut inside the last record reads every record before it
-// and reports the rest as the tail; none is misread.
+// A crash can cut the file anywhere: every cut inside the last record (cycles 100-149) reads every
+// record before it and reports the rest as the tail; none is misread.
 TEST(Journal, ATornTailAtAnyByteIsIgnoredAndEverythingBeforeItReads) {
   TempJournal file;
-  write_job(file.path, 5);
+  write_job(file.path, 150);
   const std::vector<std::uint8_t> whole = file.bytes();
-  const std::size_t last = kRecordOverheadBytes + kCyclePayloadBytes;
+  const std::vector<std::size_t> starts = record_starts(whole);
+  LONGS_EQUAL(4, starts.size());  // start, two Cycles records, the end of the file
+  const std::size_t last = whole.size() - starts[2];
   for (std::size_t cut = 1; cut < last; ++cut) {
     Seen seen;
     const JournalReadResult read = read_journal(whole.data(), whole.size() - cut, seen.visitor());
     CHECK_TRUE(read.ok);
-    LONGS_EQUAL(4, seen.cycles.size());
+    LONGS_EQUAL(100, seen.cycles.size());
     LONGS_EQUAL(last - cut, read.tail_bytes);
     CHECK_FALSE(read.tail.empty());
-    check_same(record_of(3), seen.cycles.back());
+    check_same(record_of(99), seen.cycles.back());
   }
 }
 
 TEST(Journal, AFlippedBitWithRecordsAfterItIsDamageThatSaysWhereAndInTheLastRecordATornTail) {
   TempJournal file;
-  write_job(file.path, 5);
+  write_job(file.path, 350);  // cycles 0-99, 100-199, 200-299, 300-349
   const std::vector<std::uint8_t> whole = file.bytes();
-  const std::size_t record = kRecordOverheadBytes + kCyclePayloadBytes;
-  const std::size_t start_record = kRecordOverheadBytes + 4 + 4 + 8 + 2 + std::string("journal_tests").size() + 2 +
-                                   start_of().job.size();
-  const std::size_t third = kFileHeaderBytes + start_record + 2 * record;
+  const std::vector<std::size_t> starts = record_starts(whole);
+  LONGS_EQUAL(6, starts.size());
+  const std::size_t second = starts[2];
   std::vector<std::uint8_t> bytes = whole;
-  bytes[third + 20] ^= 0x10;  // inside the third cycle record's payload
+  bytes[second + 20] ^= 0x10;  // inside the second Cycles record's payload
   Seen seen;
   JournalReadResult read = read_journal(bytes.data(), bytes.size(), seen.visitor());
   CHECK_FALSE(read.ok);
-  LONGS_EQUAL(2, seen.cycles.size());  // what came before it was read
-  LONGS_EQUAL(third, read.good_bytes);
-  STRCMP_CONTAINS(("journal offset " + std::to_string(third) + ": a record whose CRC-32 does not match, with " +
-                   std::to_string(2 * record) + " bytes after it")
+  LONGS_EQUAL(100, seen.cycles.size());  // what came before it was read
+  LONGS_EQUAL(second, read.good_bytes);
+  STRCMP_CONTAINS(("journal offset " + std::to_string(second) + ": a record whose CRC-32 does not match, with " +
+                   std::to_string(whole.size() - starts[3]) + " bytes after it")
                       .c_str(),
                   read.error.c_str());
-  const std::size_t last = whole.size() - record;
+  const std::size_t last = starts[4];
   bytes = whole;
   bytes[last + 20] ^= 0x10;  // the last record: a torn write
   Seen seen_last;
   read = read_journal(bytes.data(), bytes.size(), seen_last.visitor());
   CHECK_TRUE(read.ok);
-  LONGS_EQUAL(4, seen_last.cycles.size());
-  LONGS_EQUAL(record, read.tail_bytes);
+  LONGS_EQUAL(300, seen_last.cycles.size());
+  LONGS_EQUAL(whole.size() - last, read.tail_bytes);
   STRCMP_CONTAINS("a last record whose CRC-32 does not match", read.tail.c_str());
 }
 
@@ -264,7 +293,7 @@ TEST(Journal, NotAJournalOrAnotherVersionIsAnErrorNamingWhatWasExpected) {
   bytes[8] = 9;
   read = read_journal(bytes.data(), bytes.size(), seen.visitor());
   CHECK_FALSE(read.ok);
-  STRCMP_CONTAINS("journal offset 8: version 9; this program reads versions 2 to 4", read.error.c_str());
+  STRCMP_CONTAINS("journal offset 8: version 9; this program reads versions 2 to 5", read.error.c_str());
   read = read_journal_file("/nonexistent/journal", seen.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_EQUAL("/nonexistent/journal: cannot be read", read.error.c_str());
@@ -354,7 +383,7 @@ TEST(Journal, AMachineCommandCountsAsWrittenOnlyOnceItIsInTheFileWithEverythingB
 // last whole record, and the records after it read on.
 TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   TempJournal file;
-  write_job(file.path, 20);
+  write_job(file.path, 120);  // cycles 0-99, 100-119
   std::vector<std::uint8_t> whole = file.bytes();
   {
     std::ofstream cut(file.path, std::ios::binary | std::ios::trunc);
@@ -364,7 +393,7 @@ TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   const JournalReadResult first = read_journal_file(file.path, before.visitor());
   CHECK_TRUE(first.ok);
   CHECK(first.tail_bytes > 0);
-  LONGS_EQUAL(19, before.cycles.size());
+  LONGS_EQUAL(100, before.cycles.size());
   JournalWriter writer;
   JournalResume resume;
   resume.segment = 1;
@@ -380,13 +409,14 @@ TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   const JournalReadResult second = read_journal_file(file.path, after.visitor());
   CHECK_TRUE(second.ok);
   LONGS_EQUAL(0, second.tail_bytes);
-  LONGS_EQUAL(20, after.cycles.size());
+  LONGS_EQUAL(101, after.cycles.size());
+  CHECK_TRUE(after.cycles.back().tool_recorded);  // a run's first cycle is a key: nothing before it needed
   LONGS_EQUAL(1, after.resumes.size());
   LONGS_EQUAL(1, after.resumes[0].segment);
   LONGS_EQUAL(77, after.resumes[0].unix_time_ns);
   CHECK(after.resumes[0].script_s == 12.5 && after.resumes[0].approach_s == 40.25);
   STRCMP_EQUAL("stencil-sim", after.resumes[0].program.c_str());
-  LONGS_EQUAL(0, after.cycles.back().cycle);
+  LONGS_EQUAL(0, after.cycles.back().record.cycle);
   LONGS_EQUAL(1, after.endings.size());  // the first run was cut off: only the second ended in order
   LONGS_EQUAL(1, after.endings[0].first);
   CHECK(after.endings[0].second == SafeReason::None);
@@ -446,7 +476,7 @@ TEST(Journal, TheDrainWritesEachCommandBeforeItsCyclesRecordAndTheSafeStateWithI
 
   std::vector<std::string> order;
   JournalVisitor visit;
-  visit.cycle = [&](const JournalRecord& r) { order.push_back("cycle " + std::to_string(r.cycle)); };
+  visit.cycle = [&](const RecordedCycle& r) { order.push_back("cycle " + std::to_string(r.record.cycle)); };
   visit.command = [&](const CommandEvent& e) {
     order.push_back(std::string(stencil::control::command_kind_name(e.kind)) + " " + std::to_string(e.cycle));
   };
@@ -476,53 +506,39 @@ TEST(Journal, TheDrainWritesEachCommandBeforeItsCyclesRecordAndTheSafeStateWithI
 
 TEST(Journal, AVersion2JournalStillReadsButIsNotCarriedOn) {
   TempJournal file;
-  write_job(file.path, 20, 10);
-  // The same journal as version 2 wrote it: the version, and a safe-state record without its source.
-  std::vector<std::uint8_t> bytes = file.bytes();
-  std::vector<std::uint8_t> old(bytes.begin(), bytes.begin() + static_cast<long>(kFileHeaderBytes));
-  old[8] = 2;
-  JournalVisitor offsets;
-  std::vector<std::size_t> starts;
-  offsets.offset = [&](std::size_t offset) { starts.push_back(offset); };
-  const JournalReadResult whole = read_journal(bytes.data(), bytes.size(), offsets);
-  CHECK_TRUE(whole.ok);
-  starts.push_back(whole.good_bytes);
-  for (std::size_t i = 0; i + 1 < starts.size(); ++i) {
-    const std::size_t at = starts[i];
-    if (bytes[at + 4] != static_cast<std::uint8_t>(RecordType::SafeState)) {
-      old.insert(old.end(), bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(starts[i + 1]));
-      continue;
-    }
-    std::vector<std::uint8_t> record(bytes.begin() + static_cast<long>(at), bytes.begin() + static_cast<long>(at + 5 + 9));
-    record[0] = 9;  // the length: no source byte
-    const uLong crc = crc32(crc32(0L, Z_NULL, 0), record.data(), static_cast<uInt>(record.size()));
-    for (int b = 0; b < 4; ++b) {
-      record.push_back(static_cast<std::uint8_t>(crc >> (8 * b)));
-    }
-    old.insert(old.end(), record.begin(), record.end());
+  // As version 2 wrote it: a Cycle record per cycle, a safe-state record without its source.
+  OldJournal version2(2);
+  for (int i = 0; i < 20; ++i) {
+    version2.cycle(record_of(static_cast<std::uint64_t>(i), i >= 10 ? SafeReason::PoseJump : SafeReason::None));
   }
+  const std::vector<std::uint8_t>& old = version2.bytes();
   Seen seen;
   const JournalReadResult read = read_journal(old.data(), old.size(), seen.visitor());
   CHECK_TEXT(read.ok, read.error.c_str());
   LONGS_EQUAL(20, seen.cycles.size());
+  for (int i = 0; i < 20; ++i) {
+    const RecordedCycle& cycle = seen.cycles[static_cast<std::size_t>(i)];
+    CHECK_TRUE(cycle.tool_recorded);
+    CHECK_FALSE(cycle.maxima_recorded);  // version 5's
+    JournalRecord want = record_of(static_cast<std::uint64_t>(i), i >= 10 ? SafeReason::PoseJump : SafeReason::None);
+    check_same(want, cycle);
+  }
   LONGS_EQUAL(1, seen.events.size());
   LONGS_EQUAL(1, seen.sources.size());
   CHECK(seen.sources[0] == stencil::control::CommandSource::Cycle);
   // Carrying it on would mix versions in one file: refused, naming both.
-  {
-    std::ofstream out(file.path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(old.data()), static_cast<std::streamsize>(old.size()));
-  }
+  version2.write(file.path);
   JournalWriter writer;
   JournalResume resume;
   resume.segment = 1;
   CHECK_FALSE(writer.open_to_resume(file.path, read.good_bytes, resume));
-  STRCMP_CONTAINS("is a version 2 journal; this program carries on versions 3 to 4 only", writer.error().c_str());
+  STRCMP_CONTAINS("is a version 2 journal; this program carries on versions 3 to 5 only", writer.error().c_str());
 }
 
 // Which build made each run, after its Start and each Resume; a version 3 journal (none, and every
-// record of it a version 4 record) is carried on as version 4, its resumed run saying what made it.
-TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion4) {
+// record of it a version 5 record) is carried on as version 5, its resumed run saying what made it
+// and its cycles compact after the old ones.
+TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion5) {
   TempJournal file;
   {
     JournalWriter writer;
@@ -552,30 +568,40 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion4) {
   CHECK_EQUAL(2U, both.provenances.size());
   STRCMP_EQUAL("journal_tests v2; command: journal_tests --resume", both.provenances[1].c_str());
 
-  // A version 3 journal: the same records without Provenance.
-  write_job(file.path, 3);
-  std::vector<std::uint8_t> bytes = file.bytes();
-  bytes[8] = 3;
-  {
-    std::ofstream out(file.path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  // A version 3 journal: Cycle records, no Provenance.
+  OldJournal version3(3);
+  for (int i = 0; i < 3; ++i) {
+    version3.cycle(record_of(static_cast<std::uint64_t>(i)));
   }
+  version3.write(file.path);
   {
     JournalWriter writer;
     JournalResume resume;
     resume.segment = 1;
     resume.provenance = "journal_tests v2";
-    CHECK_TRUE(writer.open_to_resume(file.path, bytes.size(), resume));
+    CHECK_TRUE(writer.open_to_resume(file.path, version3.bytes().size(), resume));
+    CHECK_TRUE(writer.append(record_of(0)));
+    CHECK_TRUE(writer.append(record_of(1)));
     CHECK_TRUE(writer.close());
   }
   Seen old;
   read = read_journal_file(file.path, old.visitor());
   CHECK_TEXT(read.ok, read.error.c_str());
   CHECK_EQUAL(1U, old.resumes.size());
-  CHECK_EQUAL(3U, old.cycles.size());
+  CHECK_EQUAL(5U, old.cycles.size());
+  CHECK_FALSE(old.cycles[2].maxima_recorded);  // version 3's
+  CHECK_TRUE(old.cycles[4].maxima_recorded);   // the carried-on run's, compact
+  check_same(record_of(1), old.cycles[4]);
   CHECK_EQUAL(1U, old.provenances.size());
   STRCMP_EQUAL("journal_tests v2", old.provenances[0].c_str());
-  CHECK_EQUAL(4U, file.bytes()[8]);
+  CHECK_EQUAL(5U, file.bytes()[8]);
+  // A Cycles record in a version 4 journal is damage.
+  std::vector<std::uint8_t> bytes = file.bytes();
+  bytes[8] = 4;
+  Seen mixed;
+  read = read_journal(bytes.data(), bytes.size(), mixed.visitor());
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("a cycles record in a version 4 journal (version 5 has them)", read.error.c_str());
 
   // A provenance record in a version 3 journal is damage, named by its offset.
   {

@@ -112,10 +112,12 @@ TEST(MachineJournal, RecordingATargetDoesNotWaitForTheRecordsThreadsSlowWrite) {
   constexpr auto kSlowWrite = 200ms;
   storage.make_writes_take(kSlowWrite);
   const int writes_before = storage.writes_begun();
-  CHECK(cycles.push(cycle_record(0)));
+  for (std::uint64_t cycle = 0; cycle < kCyclesPerRecord; ++cycle) {  // a whole Cycles record to write
+    CHECK(cycles.push(cycle_record(cycle)));
+  }
   bool synced = false;
   std::thread records_thread([&] {
-    records.drain(cycles);     // buffers the cycle's record
+    records.drain(cycles);     // buffers the cycles' record
     synced = writer.sync();    // and writes it out: 200 ms inside write(), the writer's lock held
   });
   while (storage.writes_begun() == writes_before) {
@@ -206,7 +208,7 @@ TEST(MachineJournal, ATargetIsInTheFileWhenTheMachineSideIsToldItIsWrittenAndAll
   std::vector<std::uint64_t> cycle_numbers;
   JournalVisitor visit;
   visit.machine_command = [&](const MachineCommandRecord& c) { targets.push_back(c); };
-  visit.cycle = [&](const JournalRecord& r) { cycle_numbers.push_back(r.cycle); };
+  visit.cycle = [&](const stencil::journal::RecordedCycle& r) { cycle_numbers.push_back(r.record.cycle); };
   const JournalReadResult read = read_journal_file(file.path, visit);
   CHECK_TEXT(read.ok, read.error.c_str());
   LONGS_EQUAL(kTargets, targets.size());

@@ -14,6 +14,7 @@
 #include "firmware/services/journal/journal_writer.hpp"
 #include "toolchain/same_behaviour/journal_comparison.hpp"
 #include "toolchain/same_behaviour/report_comparison.hpp"
+#include "tests/support/old_journal.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>
@@ -62,12 +63,15 @@ void write_job(const std::string& path, const std::string& provenance, std::int6
   CHECK_TRUE(writer.close());
 }
 
-// The file as a version 3 journal (no Provenance record was written into it).
-void mark_version_3(const std::string& path) {
-  std::fstream file(path, std::ios::in | std::ios::out | std::ios::binary);
-  file.seekp(8);
-  const char three[4] = {3, 0, 0, 0};
-  file.write(three, 4);
+// The same job as version 3 (no Provenance record) or 4 wrote it: a Cycle record per cycle.
+void write_old_job(const std::string& path, std::uint32_t version, const std::string& provenance, std::int64_t start_ns,
+                   double x2 = 25.0) {
+  testing::OldJournal old(version, start_ns, provenance, "same_behaviour_tests", "pattern=raster");
+  for (std::uint64_t c = 0; c < 4; ++c) {
+    old.cycle(cycle_record(c, c == 2 ? x2 : 25.0));
+  }
+  old.end(4);
+  old.write(path);
 }
 
 }  // namespace
@@ -83,14 +87,24 @@ TEST(SameBehaviour, JournalsOfTheSameJobAreTheSameWhateverBuildAndStartWroteThem
   CHECK_EQUAL(0U, result.differences.size());
   CHECK_EQUAL(1U, result.start_times);
   CHECK_EQUAL(2U, result.provenance);
-  CHECK_EQUAL(6U, result.records);  // start, 4 cycles, end: the provenance left out
+  CHECK_EQUAL(3U, result.records);  // start, one Cycles record of 4 cycles, end: the provenance left out
+}
+
+TEST(SameBehaviour, ADifferentToolInACompactJournalIsFoundInItsCyclesRecord) {
+  TempFile older, newer;
+  write_job(older.path, "a", 1'000);
+  write_job(newer.path, "b", 2'000, 25.001);
+  const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
+  STRCMP_EQUAL("", result.error.c_str());
+  CHECK_EQUAL(1U, result.differences.size());
+  STRCMP_CONTAINS("record 1 (cycles)", result.differences[0].c_str());  // start, then the cycles
+  STRCMP_CONTAINS("its payload from byte", result.differences[0].c_str());
 }
 
 TEST(SameBehaviour, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One) {
   TempFile older, newer;
-  write_job(older.path, "", 1'000);
-  mark_version_3(older.path);
-  write_job(newer.path, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000);
+  write_old_job(older.path, 3, "", 1'000);
+  write_old_job(newer.path, 4, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000);
   const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
   STRCMP_EQUAL("", result.error.c_str());
   CHECK_EQUAL(0U, result.differences.size());
@@ -99,24 +113,19 @@ TEST(SameBehaviour, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One)
 
 TEST(SameBehaviour, ADifferenceAfterAProvenanceRecordIsFoundAndPlaced) {
   TempFile older, newer;
-  write_job(older.path, "", 1'000);
-  mark_version_3(older.path);
-  write_job(newer.path, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000, 25.001);
+  write_old_job(older.path, 3, "", 1'000);
+  write_old_job(newer.path, 4, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000, 25.001);
   const same_behaviour::JournalComparison result = same_behaviour::compare_journals(older.path, newer.path);
   STRCMP_EQUAL("", result.error.c_str());
   CHECK_EQUAL(1U, result.differences.size());
   STRCMP_CONTAINS("record 3 (cycle 2)", result.differences[0].c_str());  // start, cycles 0, 1, 2
   STRCMP_CONTAINS("its payload from byte", result.differences[0].c_str());
-  // Another version step than 3 to 4 is a difference of its own.
-  std::fstream file(older.path, std::ios::in | std::ios::out | std::ios::binary);
-  file.seekp(8);
-  const char two[4] = {2, 0, 0, 0};
-  file.write(two, 4);
-  file.close();
+  // Another version step than 3 to 4 is a difference of its own (4 to 5 changed every cycle's bytes).
+  write_old_job(older.path, 4, "x", 1'000);
   write_job(newer.path, "x", 2'000);
   const same_behaviour::JournalComparison versions = same_behaviour::compare_journals(older.path, newer.path);
   CHECK(versions.differences.size() >= 1U);
-  STRCMP_CONTAINS("the file versions differ: 2 and 4", versions.differences[0].c_str());
+  STRCMP_CONTAINS("the file versions differ: 4 and 5", versions.differences[0].c_str());
 }
 
 TEST(SameBehaviour, ReportsLeaveOutTheWallClockAndTheProvenanceButNothingElse) {

@@ -52,6 +52,7 @@ const char* type_name(RecordType type) {
     case RecordType::End: return "end";
     case RecordType::Command: return "command";
     case RecordType::Provenance: return "provenance";
+    case RecordType::Cycles: return "cycles";
   }
   return "unknown";
 }

@@ -491,6 +491,8 @@ JournalRecord Controller::build_journal_record(hal::MonotonicNs now_ns) const {
   for (int i = 0; i < 3; ++i) {
     record.force_n[i] = static_cast<float>(last_command_.force_n[i]);
   }
+  record.max_force_n = max_force_n_;
+  record.max_offset_mm = max_offset_mm_;
   record.safe_source = safe_source_;
   record.paused = paused_;
   return record;

@@ -305,6 +305,10 @@ struct JournalRecord {
   std::uint16_t status_bits;
   hal::ReadStatus read_status;
   hal::HapticFault read_reason;
+  // The run's largest force written and offset of the hand from the virtual tool so far (the cycle's
+  // running maxima): a resumed job's report covers its earlier runs without their every cycle.
+  double max_force_n;
+  double max_offset_mm;
   // Not in the Cycle record's bytes: the writer puts them in the SafeState record it writes with the
   // first record in the safe state, and the paused flag shows in the Pause and Resume records.
   CommandSource safe_source;

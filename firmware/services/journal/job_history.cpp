@@ -44,17 +44,35 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
     history.start = start;
     history.segments = 1;
   };
-  visit.cycle = [&](const control::JournalRecord& r) {
+  visit.cycle = [&](const RecordedCycle& recorded) {
+    const control::JournalRecord& r = recorded.record;
     misplaced = misplaced || !started;
+    ++history.cycles;
+    ++segment_cycles;
+    history.touched_recorded = r.touched_triangles;
+    if (!segment_has_cycle) {
+      first_ns = r.time_ns;
+      segment_has_cycle = true;
+    }
+    last_ns = r.time_ns;
+    if (recorded.maxima_recorded) {
+      history.max_force_n = std::max(history.max_force_n, r.max_force_n);
+      history.max_offset_mm = std::max(history.max_offset_mm, r.max_offset_mm);
+    }
+    // A compact cycle without its tool touched nothing new (the writer keeps the tool of every cycle
+    // whose touched set grew), so the tips recorded rebuild the whole set.
+    if (!recorded.tool_recorded) {
+      return;
+    }
     const Eigen::Vector3d tip(r.virtual_tip_mm[0], r.virtual_tip_mm[1], r.virtual_tip_mm[2]);
     if (rebuild.virtual_tip && (!history.has_cycle || tip != history.last_virtual_tip_mm)) {
       rebuild.virtual_tip(tip);
     }
     history.has_cycle = true;
     history.last_virtual_tip_mm = tip;
-    ++history.cycles;
-    ++segment_cycles;
-    history.touched_recorded = r.touched_triangles;
+    if (recorded.maxima_recorded) {
+      return;
+    }
     const double force = Eigen::Vector3d(r.force_n[0], r.force_n[1], r.force_n[2]).norm();
     history.max_force_n = std::max(history.max_force_n, force);
     if (r.safe_reason == control::SafeReason::None) {
@@ -64,11 +82,6 @@ bool read_job_history(const std::string& path, std::uint32_t tables_crc32, std::
         history.max_offset_mm = std::max(history.max_offset_mm, (desired - tip).norm());
       }
     }
-    if (!segment_has_cycle) {
-      first_ns = r.time_ns;
-      segment_has_cycle = true;
-    }
-    last_ns = r.time_ns;
   };
   visit.safe_state = [&](std::uint64_t cycle, control::SafeReason reason) {
     misplaced = misplaced || !started;

@@ -44,6 +44,8 @@ struct JobHistory {
   std::uint32_t touched_recorded = 0;   // the touched set's size at the last cycle recorded
   double max_force_n = 0.0;
   double max_offset_mm = 0.0;           // device against virtual tool, world
+  // The last virtual tool recorded whole (version 5 keeps it at keys, a second apart, and where the
+  // touched set grew; so it may be up to a second older than the last cycle).
   bool has_cycle = false;
   Eigen::Vector3d last_virtual_tip_mm = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_commanded_tip_mm = Eigen::Vector3d::Zero();  // home until the first target

@@ -30,9 +30,22 @@ class ByteWriter {
     std::memcpy(&bits, &v, sizeof bits);
     little(bits, 8);
   }
+  // LEB128: seven bits a byte, low first, the top bit set while more follow (1 to 10 bytes).
+  void varint(std::uint64_t v) {
+    while (v >= 0x80U) {
+      bytes_.push_back(static_cast<std::uint8_t>(v | 0x80U));
+      v >>= 7U;
+    }
+    bytes_.push_back(static_cast<std::uint8_t>(v));
+  }
+  // A signed number as a varint, small either side of zero: 0, -1, 1, -2 ... as 0, 1, 2, 3 ...
+  void zigzag(std::int64_t v) {
+    varint((static_cast<std::uint64_t>(v) << 1U) ^ static_cast<std::uint64_t>(v >> 63));
+  }
   void bytes(const std::uint8_t* data, std::size_t n) { bytes_.insert(bytes_.end(), data, data + n); }
   [[nodiscard]] const std::uint8_t* data() const { return bytes_.data(); }
   [[nodiscard]] std::size_t size() const { return bytes_.size(); }
+  void clear() { bytes_.clear(); }
 
  private:
   void little(std::uint64_t v, int n) {
@@ -66,6 +79,29 @@ class ByteReader {
     std::memcpy(&v, &bits, sizeof v);
     return v;
   }
+  // A varint as ByteWriter::varint writes it; more than 10 bytes, or a tenth byte over 1, is an
+  // overrun (no writer makes one).
+  std::uint64_t varint() {
+    std::uint64_t v = 0;
+    for (unsigned shift = 0; shift < 64; shift += 7) {
+      const std::uint8_t byte = u8();
+      if (overrun_ || (shift == 63 && byte > 1)) {
+        overrun_ = true;
+        return 0;
+      }
+      v |= static_cast<std::uint64_t>(byte & 0x7FU) << shift;
+      if ((byte & 0x80U) == 0) {
+        return v;
+      }
+    }
+    overrun_ = true;
+    return 0;
+  }
+  std::int64_t zigzag() {
+    const std::uint64_t v = varint();
+    return static_cast<std::int64_t>(v >> 1U) ^ -static_cast<std::int64_t>(v & 1U);
+  }
+  [[nodiscard]] std::size_t at() const { return at_; }
   [[nodiscard]] std::size_t left() const { return size_ - at_; }
   [[nodiscard]] const std::uint8_t* here() const { return data_ + at_; }
   void skip(std::size_t n) { at_ = n <= left() ? at_ + n : (overrun_ = true, size_); }

@@ -41,6 +41,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
   }
   std::size_t offset = kFileHeaderBytes;
   RecordType previous = RecordType::End;  // none yet
+  CycleDecoder decoder;
   while (offset < size) {
     const std::size_t left = size - offset;
     ByteReader head(data + offset, left);
@@ -92,6 +93,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
           return result;
         }
         start.job.assign(reinterpret_cast<const char*>(body.here()), job);
+        decoder.restart();
         if (visit.start) {
           visit.start(start);
         }
@@ -140,8 +142,32 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         r.read_status = static_cast<hal::ReadStatus>(read_status);
         r.read_reason = static_cast<hal::HapticFault>(read_reason);
+        decoder.whole_record_read();
         if (visit.cycle) {
-          visit.cycle(r);
+          RecordedCycle recorded;
+          recorded.record = r;
+          recorded.tip_check = tip_check(r.virtual_tip_mm);
+          visit.cycle(recorded);
+        }
+        break;
+      }
+      case RecordType::Cycles: {
+        if (version < kCompactVersion) {
+          result.error = at(offset) + "a cycles record in a version " + std::to_string(version) +
+                         " journal (version 5 has them)";
+          return result;
+        }
+        RecordedCycle recorded;
+        std::string why;
+        while (body.left() > 0) {
+          const std::size_t cycle_at = offset + 5 + body.at();
+          if (!decoder.decode(body, recorded, why)) {
+            result.error = at(cycle_at) + why;
+            return result;
+          }
+          if (visit.cycle) {
+            visit.cycle(recorded);
+          }
         }
         break;
       }
@@ -277,6 +303,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
           return result;
         }
         resume.program.assign(reinterpret_cast<const char*>(body.here()), name);
+        decoder.restart();
         if (visit.resume) {
           visit.resume(resume);
         }
@@ -320,7 +347,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
       default:
         result.error = at(offset) + "a record of type " + std::to_string(static_cast<int>(type)) +
                        " (expected 1 start, 2 cycle, 3 safe state, 4 homed, 5 machine command, 6 resume, 7 end, "
-                       "8 command or 9 provenance)";
+                       "8 command, 9 provenance or 10 cycles)";
         return result;
     }
     ++result.records;

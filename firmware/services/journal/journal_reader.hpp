@@ -9,13 +9,15 @@
 #include <string>
 
 #include "firmware/core/control/cycle_messages.hpp"
+#include "firmware/services/journal/cycle_codec.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
 
 namespace stencil::journal {
 
 struct JournalVisitor {
   std::function<void(const JournalStart&)> start;
-  std::function<void(const control::JournalRecord&)> cycle;
+  // Every cycle, from a Cycle record (versions 2 to 4) or a Cycles record (version 5).
+  std::function<void(const RecordedCycle&)> cycle;
   std::function<void(std::uint64_t cycle, control::SafeReason)> safe_state;
   // The same record with where it came from (version 2: CommandSource::Cycle).
   std::function<void(std::uint64_t cycle, control::SafeReason, control::CommandSource)> safe_source;

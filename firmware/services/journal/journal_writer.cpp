@@ -71,6 +71,9 @@ bool JournalWriter::open(const std::string& path, const JournalStart& start) {
   payload.u16(static_cast<std::uint16_t>(job_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(start.job.data()), job_length);
   add_record(RecordType::Start, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  encoder_.restart();
+  cycles_.clear();
+  cycles_in_record_ = 0;
   add_provenance(start.provenance);
   const bool synced = sync_locked(lock);
   accepting_.store(synced);
@@ -90,9 +93,10 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
     return fail("cannot read its header", errno);
   }
   ByteReader version_bytes(header + sizeof kMagic, 4);
-  // Version 3's records are all version 4's (4 adds the Provenance record): such a journal is carried
-  // on as version 4, its header's version rewritten first. Anything older is not.
-  constexpr std::uint32_t kOldestCarriedOn = kProvenanceVersion - 1;
+  // Version 3's and 4's records are all version 5's (4 adds the Provenance record, 5 the Cycles
+  // record; the reader takes a Cycle record in any version): such a journal is carried on as
+  // version 5, its header's version rewritten first. Anything older is not.
+  constexpr std::uint32_t kOldestCarriedOn = 3;
   const std::uint32_t version = version_bytes.u32();
   if (version < kOldestCarriedOn || version > kVersion) {
     return fail("is a version " + std::to_string(version) + " journal; this program carries on versions " +
@@ -121,6 +125,9 @@ bool JournalWriter::open_to_resume(const std::string& path, std::size_t good_byt
   payload.u16(static_cast<std::uint16_t>(name_length));
   payload.bytes(reinterpret_cast<const std::uint8_t*>(resume.program.data()), name_length);
   add_record(RecordType::Resume, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  encoder_.restart();
+  cycles_.clear();
+  cycles_in_record_ = 0;
   add_provenance(resume.provenance);
   const bool synced = sync_locked(lock);
   accepting_.store(synced);
@@ -207,7 +214,18 @@ void JournalWriter::wait_for_machine_commands(std::chrono::nanoseconds most) {
   }
 }
 
+void JournalWriter::end_cycles() {
+  if (cycles_.size() > 0) {
+    add_record(RecordType::Cycles, cycles_.data(), static_cast<std::uint32_t>(cycles_.size()));
+    cycles_.clear();
+  }
+  cycles_in_record_ = 0;
+}
+
 void JournalWriter::add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length) {
+  if (type != RecordType::Cycles) {
+    end_cycles();
+  }
   ByteWriter head;
   head.u32(length);
   head.u8(static_cast<std::uint8_t>(type));
@@ -226,9 +244,12 @@ bool JournalWriter::append(const control::JournalRecord& r) {
   if (fd_ < 0 || failed_ || !write_machine_commands_locked()) {
     return false;
   }
-  ByteWriter payload;
-  encode_cycle(r, payload);
-  add_record(RecordType::Cycle, payload.data(), static_cast<std::uint32_t>(payload.size()));
+  encoder_.encode(r, cycles_);
+  // Ended by the records alone (never by when the disk is written), so the same job gives the same
+  // bytes; the open one is at most 100 ms of cycles that a write-out leaves for the next.
+  if (++cycles_in_record_ >= kCyclesPerRecord || cycles_.size() >= kCyclesRecordBytes) {
+    end_cycles();
+  }
   ++cycle_records_;
   if (r.safe_reason != control::SafeReason::None && !in_safe_state_) {
     in_safe_state_ = true;
@@ -331,6 +352,9 @@ bool JournalWriter::close() {
   accepting_.store(false);  // the machine thread is done by now; a target queued after this is refused
   if (fd_ < 0) {
     return !failed_;
+  }
+  if (!failed_) {
+    end_cycles();
   }
   const bool synced = failed_ ? false : sync_locked(lock);
   const bool closed = ::close(fd_) == 0;

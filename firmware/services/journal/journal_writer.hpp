@@ -29,6 +29,8 @@
 #include "firmware/core/control/cycle_messages.hpp"
 #include "firmware/core/control/machine_record.hpp"
 #include "firmware/core/control/spsc_ring.hpp"
+#include "firmware/services/journal/cycle_codec.hpp"
+#include "firmware/services/journal/journal_bytes.hpp"
 #include "firmware/services/journal/journal_format.hpp"
 #include "firmware/services/journal/journal_storage.hpp"
 
@@ -134,6 +136,7 @@ class JournalWriter {
   [[nodiscard]] bool sync_locked(std::unique_lock<std::mutex>& lock);
   [[nodiscard]] bool write_machine_commands_locked();
   void add_record(RecordType type, const std::uint8_t* payload, std::uint32_t length);
+  void end_cycles();  // the cycles encoded so far into a Cycles record, before anything else
   void add_provenance(const std::string& text);  // a Provenance record, when there is a text
   [[nodiscard]] bool write_out();
   [[nodiscard]] bool fail(const std::string& what, int error_number);
@@ -156,6 +159,9 @@ class JournalWriter {
   std::string path_;
   std::string error_;
   std::vector<std::uint8_t> buffer_;
+  CycleEncoder encoder_;
+  ByteWriter cycles_;  // the open Cycles record's payload
+  std::uint32_t cycles_in_record_ = 0;
   bool failed_ = false;
   bool in_safe_state_ = false;
   std::int64_t last_sync_ns_ = 0;
