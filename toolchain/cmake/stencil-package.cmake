@@ -4,7 +4,7 @@
 # libraries only (dpkg-shlibdeps finds them from the programs) and adduser for its service user.
 include(GNUInstallDirs)
 
-set(stencil_programs stencil-sim stencil-rig stencil-display stencil-tablegen stencil-sample-parts)
+set(stencil_programs stencil-sim stencil-rig stencil-display stencil-journal stencil-tablegen stencil-sample-parts)
 set(stencil_installed_programs)
 foreach(program IN LISTS stencil_programs)
   if(TARGET ${program})
@@ -40,6 +40,7 @@ if(HELP2MAN_PROGRAM)
   set(name_stencil-sim "the haptic stencil controller against a simulated device, CY545 and mill")
   set(name_stencil-rig "the haptic stencil controller on the rig, and its control commands")
   set(name_stencil-display "the haptic stencil controller's operator display (a web page)")
+  set(name_stencil-journal "what a haptic stencil job's journal holds")
   set(name_stencil-tablegen "STL part and tool to the stencil's validated tables (.stbl)")
   set(name_stencil-sample-parts "write the haptic stencil's sample parts as STL")
   foreach(program IN LISTS stencil_installed_programs)

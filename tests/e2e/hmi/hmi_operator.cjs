@@ -38,12 +38,14 @@ function fail(message) {
   throw new Error(message);
 }
 
-// The journal's records (journal_format.hpp): Cycle, SafeState, MachineCommand and Command (the
-// others, Start, Homed, Provenance and End among them, are stepped over).
+// The journal's records (journal_format.hpp): SafeState, MachineCommand and Command read here byte
+// by byte (the others, Start, Homed, Provenance and End among them, are stepped over); the cycles,
+// compact in Cycles records, through stencil-journal (the controllers' own reader), with the check
+// that stands for each cycle's virtual tool.
 function readJournal(file) {
   const b = fs.readFileSync(file);
-  if (b.toString('latin1', 0, 8) !== 'STENCILJ' || b.readUInt32LE(8) !== 4) {
-    fail(`${file}: not a version 4 journal`);
+  if (b.toString('latin1', 0, 8) !== 'STENCILJ' || b.readUInt32LE(8) !== 5) {
+    fail(`${file}: not a version 5 journal`);
   }
   const out = { cycles: [], safeStates: [], machine: [], commands: [] };
   let at = 12;
@@ -52,9 +54,7 @@ function readJournal(file) {
     const type = b.readUInt8(at + 4);
     const p = at + 5;
     if (p + length + 4 > b.length) break;
-    if (type === 2) {
-      out.cycles.push({ cycle: Number(b.readBigUInt64LE(p)), tip: [b.readDoubleLE(p + 61), b.readDoubleLE(p + 69), b.readDoubleLE(p + 77)] });
-    } else if (type === 3) {
+    if (type === 3) {
       out.safeStates.push({ cycle: Number(b.readBigUInt64LE(p)), reason: b.readUInt8(p + 8), source: SOURCE[b.readUInt8(p + 9)] });
     } else if (type === 5) {
       out.machine.push({ update: Number(b.readBigUInt64LE(p)), timeNs: Number(b.readBigInt64LE(p + 8)) });
@@ -66,6 +66,14 @@ function readJournal(file) {
       });
     }
     at = p + length + 4;
+  }
+  const cycles = spawnSync(path.join(path.dirname(simPath), 'stencil-journal'), ['cycles', file],
+    { encoding: 'utf8', maxBuffer: 1 << 30 });
+  if (cycles.status !== 0) fail(`stencil-journal cycles ${file}: ${cycles.stderr}`);
+  for (const line of cycles.stdout.split('\n')) {
+    if (!line) continue;
+    const c = JSON.parse(line);
+    out.cycles.push({ cycle: c.cycle, tip: c.tip_check });
   }
   return out;
 }
@@ -209,7 +217,7 @@ async function setParameter(page, input, name, value) {
   if (!pause || !resume) fail('the journal lacks the pause or the resume');
   const planned = journal.machine.filter((c) => c.timeNs - 3 * UPDATE_NS > pause.timeNs && c.timeNs - 3 * UPDATE_NS < resume.timeNs);
   const held = journal.cycles.filter((c) => c.cycle >= pause.cycle && c.cycle < resume.cycle);
-  const moved = held.filter((c) => c.tip.join() !== held[0].tip.join());
+  const moved = held.filter((c) => c.tip !== held[0].tip);  // the tip's CRC-32: the same tip, the same check
   const after = journal.machine.filter((c) => c.timeNs - 3 * UPDATE_NS > resume.timeNs && c.timeNs - 3 * UPDATE_NS < stop.timeNs);
   console.log(`paused cycles ${pause.cycle}..${resume.cycle}: ${planned.length} machine commands planned, ${moved.length} cycles ` +
     `with the tool moved; after Resume ${after.length} machine commands; machine holds ${report.commands.machine_holds}`);

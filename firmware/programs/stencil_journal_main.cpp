@@ -1,0 +1,130 @@
+// stencil-journal: what a job's journal holds, read with the one reader the controllers use. For a
+// machinist (how far did the job get, where did it stop, how big is it) and for the tests (every
+// cycle, target and command is in the file, whatever the format packs it into).
+#include <cinttypes>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "firmware/core/control/safe_state.hpp"
+#include "firmware/services/journal/journal_reader.hpp"
+#include "firmware/services/report/build_version.hpp"
+
+namespace {
+
+using namespace stencil;
+
+constexpr int kExitRead = 0;
+constexpr int kExitUnreadable = 1;  // not a journal, or damaged (the reader's error on stderr)
+constexpr int kExitUsage = 2;
+
+struct Counts {
+  std::uint32_t version = 0;
+  std::uint64_t runs = 0, cycles = 0, tools_kept = 0, safe_states = 0, homings = 0, machine_commands = 0,
+                commands = 0, ends = 0, provenance = 0;
+  std::uint64_t first_cycle_of_run = 0, last_cycle = 0;
+  control::SafeReason last_end = control::SafeReason::None;
+  bool ended = false;  // the last run has its End record
+};
+
+void print_summary(const std::string& path, const Counts& c, const journal::JournalReadResult& read) {
+  std::printf("journal: %s (version %u)\n", path.c_str(), c.version);
+  std::printf("runs: %" PRIu64 " (%s)\n", c.runs,
+              c.ended ? "the last ended in order" : "the last has no end record: interrupted, it may be resumed");
+  std::printf("cycles: %" PRIu64 " (their tool kept whole in %" PRIu64 ")\n", c.cycles, c.tools_kept);
+  std::printf("machine_commands: %" PRIu64 "\ncommands: %" PRIu64 "\nsafe_states: %" PRIu64 "\nhomings: %" PRIu64
+              "\nends: %" PRIu64 "\nprovenance: %" PRIu64 "\n",
+              c.machine_commands, c.commands, c.safe_states, c.homings, c.ends, c.provenance);
+  std::printf("bytes: %zu whole, %zu torn tail%s%s\n", read.good_bytes, read.tail_bytes, read.tail.empty() ? "" : ": ",
+              read.tail.c_str());
+  std::printf("bytes_per_cycle: %.2f\n", c.cycles > 0 ? static_cast<double>(read.good_bytes) / static_cast<double>(c.cycles) : 0.0);
+  if (c.ends > 0) {
+    std::printf("last_end: %s\n", control::safe_reason_name(c.last_end));
+  }
+}
+
+// One line of JSON per cycle: what the cycle read and left (the tip null where only its check was kept).
+void print_cycle(const journal::RecordedCycle& cycle) {
+  const control::JournalRecord& r = cycle.record;
+  std::printf("{\"cycle\": %" PRIu64 ", \"time_ns\": %" PRId64 ", \"device_mm\": [%.17g, %.17g, %.17g], \"fresh\": %s, ",
+              r.cycle, r.time_ns, r.device_mm[0], r.device_mm[1], r.device_mm[2], r.fresh ? "true" : "false");
+  if (cycle.tool_recorded && std::isfinite(r.virtual_tip_mm[0])) {
+    std::printf("\"tip_mm\": [%.17g, %.17g, %.17g], \"force_n\": [%.9g, %.9g, %.9g], ", r.virtual_tip_mm[0],
+                r.virtual_tip_mm[1], r.virtual_tip_mm[2], static_cast<double>(r.force_n[0]), static_cast<double>(r.force_n[1]),
+                static_cast<double>(r.force_n[2]));
+  } else {
+    std::printf("\"tip_mm\": null, \"force_n\": null, ");
+  }
+  std::printf("\"tip_check\": %" PRIu32 ", \"touched\": %" PRIu32 ", \"safe_state\": \"%s\"}\n", cycle.tip_check,
+              r.touched_triangles, control::safe_reason_name(r.safe_reason));
+}
+
+int read(const std::string& path, bool cycles_json) {
+  Counts c;
+  journal::JournalVisitor visit;
+  visit.start = [&](const journal::JournalStart&) { ++c.runs; };
+  visit.resume = [&](const journal::JournalResume&) {
+    ++c.runs;
+    c.ended = false;
+  };
+  visit.cycle = [&](const journal::RecordedCycle& cycle) {
+    ++c.cycles;
+    c.tools_kept += cycle.tool_recorded ? 1 : 0;
+    if (cycles_json) {
+      print_cycle(cycle);
+    }
+  };
+  visit.safe_state = [&](std::uint64_t, control::SafeReason) { ++c.safe_states; };
+  visit.homed = [&](std::int64_t) { ++c.homings; };
+  visit.machine_command = [&](const control::MachineCommandRecord&) { ++c.machine_commands; };
+  visit.command = [&](const control::CommandEvent&) { ++c.commands; };
+  visit.end = [&](std::uint64_t, control::SafeReason reason) {
+    ++c.ends;
+    c.ended = true;
+    c.last_end = reason;
+  };
+  visit.provenance = [&](const std::string&) { ++c.provenance; };
+  const journal::JournalReadResult result = journal::read_journal_file(path, visit);
+  if (!result.ok) {
+    std::fprintf(stderr, "stencil-journal: %s\n", result.error.c_str());
+    return kExitUnreadable;
+  }
+  if (!cycles_json) {
+    std::FILE* file = std::fopen(path.c_str(), "rb");
+    unsigned char header[12] = {};
+    if (file != nullptr && std::fread(header, 1, sizeof header, file) == sizeof header) {
+      c.version = header[8] | header[9] << 8U | header[10] << 16U | static_cast<std::uint32_t>(header[11]) << 24U;
+    }
+    if (file != nullptr) {
+      std::fclose(file);
+    }
+    print_summary(path, c, result);
+  }
+  return kExitRead;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"stencil-journal: what a job's journal holds (read as stencil-sim --resume and --replay read it)"};
+  app.set_version_flag("--version", stencil::report::version_text("stencil-journal"));
+  app.require_subcommand(1);
+  std::string path;
+  CLI::App* summary = app.add_subcommand("summary", "runs, cycles, machine targets, commands, safe states and ends "
+                                                    "counted; the bytes and the bytes per cycle; a torn tail named");
+  summary->add_option("journal", path, "the journal file")->required();
+  CLI::App* cycles = app.add_subcommand("cycles", "every cycle as a line of JSON: cycle, time_ns, device_mm, fresh, "
+                                                  "tip_mm and force_n (null where the journal kept only the tip's "
+                                                  "CRC-32, tip_check), touched, safe_state");
+  cycles->add_option("journal", path, "the journal file")->required();
+  app.footer("Exit status: 0 read (a torn tail is reported, not an error), 1 not a journal or damaged (the offset "
+             "and what was expected on stderr), 2 usage.");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitUsage);  // --help and --version: 0
+  }
+  return read(path, cycles->parsed());
+}
