@@ -582,6 +582,8 @@ int main(int argc, char** argv) {
   // The display, before the job: a page opened now sees the job from its start.
   app::Display display;
   if (!display.start(o.display, part, board::sim::controller_config(o.real_time(), job.rig), "stencil-sim", error)) {
+    // Nothing ran: no journal of it left behind (an empty job's folder would be kept as resumable).
+    static_cast<void>(journal::undo_unrun_job_journal(request, journal_writer, journal_path));
     return refuse(error);
   }
   job.display = display.feed();
