@@ -4,7 +4,7 @@
 all: build
 
 help:
-	@echo "make demo       install dependencies, build, and run the host simulation on the baked-in hex prism (raster job)"
+	@echo "make demo       install dependencies, build, and run the host simulation on the baked-in hex prism (raster job; outputs in build/demo/latest/)"
 	@echo "make test       install dependencies, configure, build and run every test (release preset)"
 	@echo "make e2e        the end-to-end tests only, the operator display in headless Chromium among them"
 	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
@@ -42,10 +42,10 @@ bench: build
 	build/bin/stencil-bench
 
 # The main job: the host simulation on the baked-in sample part, a raster job until every reachable
-# triangle is touched; the report and its picture land in build/demo/.
+# triangle is touched; its folder under build/demo/ (the last three kept) holds the report, its picture
+# and the journal, and build/demo/latest/ is the newest.
 demo: build
-	mkdir -p build/demo
-	build/bin/stencil-sim --fast --pattern raster --until-complete --journal build/demo/job.journal --report build/demo/report.json
+	build/bin/stencil-sim --fast --pattern raster --until-complete --out-dir build/demo --keep-jobs 3
 
 test-asan: deps
 	cmake --preset asan

@@ -119,7 +119,8 @@ step "a job left for the service as a machinist would: the display enabled, the 
 in_root systemctl enable stencil-display.service || fail "systemctl enable stencil-display"
 [ -L "$root/etc/systemd/system/multi-user.target.wants/stencil-display.service" ] || fail "the display is not enabled"
 cp "$root/home/machinist/hex.stbl" "$root/var/lib/stencil/part.stbl"
-cp "$root"/home/machinist/stencil-sim-*.journal "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000.journal"
+mkdir -p "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000"
+cp "$root"/home/machinist/.local/state/stencil/jobs/latest/job.journal "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000/job.journal"
 in_root chown -R stencil:stencil /var/lib/stencil
 
 step "purge"
@@ -135,7 +136,7 @@ echo "${left:-(nothing)}" | sed 's/^/  /'
 # The runs only: users' in their homes, the service's in /var/lib/stencil (its journals and the tables
 # they were cut from), given to root.
 if grep -vE '^\./(home/|var/lib/stencil($|/))' <<<"$left" | grep -q .; then fail "the purge left files besides the runs"; fi
-[ -f "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000.journal" ] || fail "the purge took the service's run"
+[ -f "$root/var/lib/stencil/jobs/stencil-rig-20261203-120000/job.journal" ] || fail "the purge took the service's run"
 if [ -n "$(cd "$root" && find ./var/lib/stencil ! -user root 2>/dev/null)" ]; then
   fail "files in /var/lib/stencil still belong to the removed user"
 fi

@@ -49,6 +49,8 @@ left_out() {
   case $1 in
     sigterm_* | sighup_* | sigquit_* | kill_*) echo "a signal mid-cut (the wall clock decides when)" ;;
     rig_*) echo "stencil-rig" ;;
+    job_and_its_resume_share_one_folder) echo "its resume names the job's folder, which older builds do not make" ;;
+    retention_keeps_an_interrupted_job) echo "a SIGKILL once the journal is open (the wall clock decides when)" ;;
     refuses_a_bad_display_option) echo "its last refusal is stencil-rig's" ;;
   esac
 }
@@ -72,10 +74,14 @@ if [ -n "${SAME_BEHAVIOUR_CASES:-}" ]; then
   read -r -a job_names <<<"$SAME_BEHAVIOUR_CASES"
 fi
 
-# make demo's command, as the Makefile has it, run in the job's folder.
+# make demo's job, as the Makefile has it, run in the job's folder: its outputs named with --journal and
+# --report, which every build takes (its --out-dir and --keep-jobs, for a job folder named after the
+# wall clock, left out; older builds have neither).
 demo_line=$(sed -n '/^demo:/,/^$/p' "$repo/Makefile" | grep -m1 'build/bin/stencil-sim ') ||
   die "$repo/Makefile: no stencil-sim command under demo:"
-read -r -a demo_arguments <<<"$(echo "$demo_line" | sed -e 's|^[[:space:]]*build/bin/stencil-sim||' -e 's|build/demo/||g')"
+read -r -a demo_arguments <<<"$(echo "$demo_line" | sed -E -e 's|^[[:space:]]*build/bin/stencil-sim||' -e 's|build/demo/||g' \
+  -e 's/--(out-dir|keep-jobs|keep-mb|journal|report)[ =][^ ]+//g')"
+demo_arguments+=(--journal job.journal --report report.json)
 
 # --- The two builds -------------------------------------------------------------------------------
 
@@ -154,14 +160,24 @@ run_jobs new "$new_build/bin/stencil-sim"
 # --- The comparison -------------------------------------------------------------------------------
 
 # outputs DIR: "key<TAB>path" for each file compared, sorted by key; a journal named after its start
-# time gets the key stencil-sim-<n>.journal, n its place among those in its folder.
+# time gets the key stencil-sim-<n>.journal, n its place among those in its folder. A job's own folder
+# under the case's $XDG_STATE_HOME (sim_cli.sh's xdg-state/stencil/jobs/stencil-sim-YYYYMMDD-HHMMSS/)
+# is taken as the case's folder with the names builds before job folders gave: its job.journal as a
+# journal named after its start time, report.json and its picture as stencil-sim-report.*.
 outputs() {
   (cd "$1" && find . -type f \( -name '*.json' -o -name '*.journal' -o -name '*.csv' -o -name '*.svg' \) | sed 's|^\./||' | LC_ALL=C sort) |
     awk '{
       n = split($0, parts, "/")
       folder = substr($0, 1, length($0) - length(parts[n]))
       key = $0
-      if (parts[n] ~ /^stencil-sim-[0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9]-[0-9][0-9][0-9][0-9][0-9][0-9][.]journal$/) {
+      stamp = "stencil-sim-[0-9][0-9][0-9][0-9][0-9][0-9][0-9][0-9]-[0-9][0-9][0-9][0-9][0-9][0-9]"
+      if ($0 ~ ("^xdg-state/stencil/jobs/" stamp "(-[0-9]+)?/[^/]+$")) {
+        folder = ""
+        key = parts[n] ~ /^report[.]/ ? "stencil-sim-" parts[n] : parts[n]
+        if (parts[n] == "job.journal") {
+          key = "stencil-sim-(start time " (++count[folder]) ").journal"
+        }
+      } else if (parts[n] ~ ("^" stamp "[.]journal$")) {
         key = folder "stencil-sim-(start time " (++count[folder]) ").journal"
       }
       print key "\t" $0

@@ -184,8 +184,15 @@ const Key kKeys[] = {
   // [job]
   {"job.work_offset_mm", Kind::Reals3, -10000, 10000, true, "x y z: the tool tip in the part's frame at home",
    [](RigConfig& c, const Value& v) { c.work_offset_mm = v.n; }},
-  {"job.output_folder", Kind::Text, 0, 0, false, "folder for journals; empty or absent: the current folder",
+  {"job.output_folder", Kind::Text, 0, 0, false,
+   "the jobs folder, each job's own folder in it; empty or absent: $XDG_STATE_HOME/stencil/jobs (--out-dir overrides)",
    [](RigConfig& c, const Value& v) { c.output_folder = v.text; }},
+  {"job.keep_jobs", Kind::Integer, 0, 100000, false,
+   "job folders kept as a new job starts, it counted; never one that may be resumed (0: all; absent: 50)",
+   [](RigConfig& c, const Value& v) { c.keep_jobs = static_cast<unsigned>(v.n[0]); }},
+  {"job.keep_mb", Kind::Integer, 0, 100000000, false,
+   "MB of job folders kept as a new job starts, newest first; never one that may be resumed (0 or absent: no cap)",
+   [](RigConfig& c, const Value& v) { c.keep_mb = static_cast<unsigned>(v.n[0]); }},
   // [commissioning]
   {"commissioning.jog_mm", Kind::Real, 0.5, 20, true, "mm each axis moves into its travel, then back half of it",
    [](RigConfig& c, const Value& v) { c.commissioning.jog_mm = v.n[0]; }},

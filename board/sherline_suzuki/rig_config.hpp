@@ -23,7 +23,9 @@ struct RigConfig {
   int cycle_priority = 80;          // SCHED_FIFO
   int machine_priority = 70;        // SCHED_FIFO, below the cycle (it always preempts the machine thread)
   std::array<double, 3> work_offset_mm = kHomeWorldMm;  // the tool tip in the part's frame with the machine at home
-  std::string output_folder;        // where journals go by default ("": the current folder)
+  std::string output_folder;        // the jobs folder, each job's own folder in it ("": the program's default)
+  unsigned keep_jobs = 50;          // job folders kept as a new job starts, it counted (0: every one)
+  unsigned keep_mb = 0;             // MB of job folders kept as a new job starts (0: no cap)
   CommissioningSettings commissioning;
   std::uint32_t file_crc32 = 0;     // the file's CRC-32, recorded with a job (0: the compiled-in rig)
 };

@@ -31,8 +31,11 @@ struct RigOptions {
   double stick_out = 0.0;
   double reference_stick_out = 0.0;
   std::string stock_text;     // empty: the whole workspace
-  std::string report_path;
-  std::string journal_path;
+  std::string report_path;    // empty: report.json in the job's folder (a --resume's report-resume-N.json)
+  std::string journal_path;   // empty: job.journal in the job's folder
+  std::string out_dir;        // --out-dir: the jobs folder (empty: the file's job.output_folder, else the XDG default)
+  unsigned keep_jobs = 50;    // --keep-jobs, else the file's job.keep_jobs
+  unsigned keep_mb = 0;       // --keep-mb, else the file's job.keep_mb
   bool no_journal = false;
   std::string resume_path;
   double duration_s = 0.0;

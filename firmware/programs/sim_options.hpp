@@ -22,6 +22,9 @@ struct SimOptions {
   board::sherline_suzuki::CommissioningSettings commissioning;  // the file's [commissioning]
   std::uint32_t config_crc32 = 0, mill_truth_crc32 = 0;          // the files', for the journal's job (0: none)
   std::string output_folder;                                     // the file's job.output_folder
+  std::string out_dir;        // --out-dir: the jobs folder this job's own folder is made in (empty: the default)
+  unsigned keep_jobs = 50;    // --keep-jobs, else the file's job.keep_jobs (0: every job kept)
+  unsigned keep_mb = 0;       // --keep-mb, else the file's job.keep_mb (0: no size cap)
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
   std::string pattern_name = "raster";
@@ -33,7 +36,7 @@ struct SimOptions {
   int priority = 80;
   int cpu = -1;
   bool require_rt = false;
-  std::string report_path = "stencil-sim-report.json";
+  std::string report_path;    // empty: report.json in the job's folder (report-resume-N.json, replay.json)
   bool until_complete = false;
   std::string stock_text;
   std::string inject_text;

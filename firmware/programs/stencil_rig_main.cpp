@@ -8,6 +8,8 @@
 
 #include <atomic>
 #include <cstdio>
+#include <cstdlib>
+#include <ctime>
 #include <string>
 #include <vector>
 
@@ -30,6 +32,7 @@
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
 #include "firmware/services/report/build_version.hpp"
+#include "firmware/services/report/job_folder.hpp"
 
 namespace {
 
@@ -64,14 +67,44 @@ std::string job_text_of(const board::sherline_suzuki::WorkOffset& offset, const 
   return std::string(text) + config;
 }
 
+// Where the job writes: a new job's own folder under the jobs folder (retention first, then the
+// folder made; none when the report and the journal are both given or none is asked and no --out-dir),
+// or a --resume's journal's folder. The report and journal land there unless given. False with the message.
+bool place_outputs(app::RigOptions& o, std::uint32_t resume_segment, report::JobFolder& folder, std::string& error) {
+  std::string report_name = "report.json";
+  if (!o.resume_path.empty()) {
+    folder.use_folder_of(o.resume_path);
+    report_name = "report-resume-" + std::to_string(resume_segment) + ".json";
+  } else if (!o.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal)) {
+    const report::JobFolderRequest request{
+        "stencil-rig",
+        o.out_dir.empty()
+            ? report::default_jobs_folder(o.config.output_folder, std::getenv("XDG_STATE_HOME"), std::getenv("HOME"))
+            : o.out_dir,
+        {o.keep_jobs, std::uint64_t{o.keep_mb} * 1'000'000U}};
+    if (!folder.make(request, std::time(nullptr),
+                     [](const std::string& line) { std::printf("stencil-rig: %s\n", line.c_str()); }, error)) {
+      error = (o.out_dir.empty() ? "" : "--out-dir: ") + error;
+      return false;
+    }
+    std::printf("stencil-rig: job folder %s\n", folder.path().c_str());
+    if (!o.no_journal && o.journal_path.empty()) {
+      o.journal_path = folder.place("", "job.journal");
+    }
+  }
+  if (o.report_path.empty()) {
+    o.report_path = folder.place("", report_name);
+  }
+  return true;
+}
+
 // The journal as asked: a fresh one, none, or (--resume) the job's own once it is found to be this
-// job. False with the message for the terminal.
-bool open_journal(const app::RigOptions& o, const tables::PartTables& part, const RigJob& job,
+// job; the job's folder and its outputs' places before it (place_outputs). False with the message
+// for the terminal.
+bool open_journal(app::RigOptions& o, const tables::PartTables& part, const RigJob& job, report::JobFolder& folder,
                   journal::JobJournalRequest& request, journal::JournalWriter& writer, std::string& opened_path,
                   std::string& error) {
   request.program = "stencil-rig";
-  request.path = o.journal_path;
-  request.folder = o.config.output_folder;
   request.none = o.no_journal;
   request.resume_path = o.resume_path;
   request.start.tables_crc32 = part.header.crc32;
@@ -97,13 +130,29 @@ bool open_journal(const app::RigOptions& o, const tables::PartTables& part, cons
                 history.faults.size(), static_cast<unsigned long long>(history.machine_commands),
                 history.tail.empty() ? "" : ("; its torn tail ignored (" + history.tail + ")").c_str());
   }
+  if (!place_outputs(o, request.resume.segment, folder, error)) {
+    return false;
+  }
+  request.path = o.journal_path;
   if (!journal::open_job_journal(request, writer, opened_path, error)) {
+    folder.abandon();
     return false;
   }
   if (o.resume_path.empty() && !opened_path.empty()) {
     std::printf("stencil-rig: journal %s\n", opened_path.c_str());
   }
   return true;
+}
+
+// What made this run, for the report and the journal.
+void fill_provenance(app::RigOptions& o, int argc, char** argv, const tables::PartTables& part) {
+  o.provenance.program = "stencil-rig";
+  o.provenance.command_line.assign(argv, argv + argc);
+  o.provenance.configuration = o.config_path;
+  o.provenance.configuration_crc32 = o.config.file_crc32;
+  o.provenance.tables = o.tables_path;
+  o.provenance.tables_crc32 = part.header.crc32;
+  o.provenance.triangle_count = part.header.triangle_count;
 }
 
 // The machine thread runs SCHED_FIFO below the cycle (which always preempts it) and above the
@@ -230,7 +279,9 @@ int main(int argc, char** argv) {
       "stopped (re-homing to resume the cut is not built yet).\n"
       "With no terminal (a service), the same come over the controller's socket (--display-socket):\n"
       "stencil-rig status|stop|reset|pause|resume|start [--socket PATH] from its own user or root.\n"
-      "Exit status: 0 stopped as asked with no fault, 2 bad input, 3 could not start or a fault happened;\n"
+      "Each job writes its journal and report in a folder of its own (--out-dir), a --resume of it there too.\n"
+      "Exit status: 0 stopped as asked with no fault, 2 bad input (a jobs folder that cannot be written\n"
+      "among it), 3 could not start or a fault happened;\n"
       "a control command: 0 done, 1 refused by the controller, 3 no controller."};
   app.set_version_flag("--version", report::version_text("stencil-rig"));
   app::RigOptions o;
@@ -264,13 +315,7 @@ int main(int argc, char** argv) {
     return fail(kExitBadInput, error);
   }
   job.facts = o.config.facts;
-  o.provenance.program = "stencil-rig";
-  o.provenance.command_line.assign(argv, argv + argc);
-  o.provenance.configuration = o.config_path;
-  o.provenance.configuration_crc32 = o.config.file_crc32;
-  o.provenance.tables = o.tables_path;
-  o.provenance.tables_crc32 = part.header.crc32;
-  o.provenance.triangle_count = part.header.triangle_count;
+  fill_provenance(o, argc, argv, part);
   const board::sherline_suzuki::TableFitJob fit{
       {job.offset.home_world_mm.x(), job.offset.home_world_mm.y(), job.offset.home_world_mm.z()},
       job.offset.tool_stick_out_mm, job.offset.reference_stick_out_mm};
@@ -296,7 +341,8 @@ int main(int argc, char** argv) {
   journal::JobJournalRequest request;
   journal::JournalWriter journal_writer;
   std::string journal_path;
-  if (!open_journal(o, part, job, request, journal_writer, journal_path, error)) {
+  report::JobFolder folder;  // checked (made, written in) before anything moves
+  if (!open_journal(o, part, job, folder, request, journal_writer, journal_path, error)) {
     return fail(kExitBadInput, error);
   }
   // Every signal that ends a session ends the job through the cycle's stop (spindle and drivers off):
@@ -315,6 +361,7 @@ int main(int argc, char** argv) {
     if (!journal::undo_unrun_job_journal(request, journal_writer, journal_path)) {
       std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", o.resume_path.c_str());
     }
+    folder.abandon();
     return fail(kExitBadInput, error);
   }
   job.display = display.feed();
@@ -345,6 +392,7 @@ int main(int argc, char** argv) {
     if (!journal::undo_unrun_job_journal(request, journal_writer, journal_path)) {
       std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", o.resume_path.c_str());
     }
+    folder.abandon();
     const std::string link_error = devices.link->last_error();
     return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));
   }

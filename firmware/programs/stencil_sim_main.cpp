@@ -5,6 +5,7 @@
 #include <chrono>
 #include <ctime>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <iostream>
@@ -24,6 +25,7 @@
 #include "board/sim/sim_job.hpp"
 #include "board/sim/sim_report.hpp"
 #include "firmware/services/report/build_version.hpp"
+#include "firmware/services/report/job_folder.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/output_probe.hpp"
 #include "board/sherline_suzuki/table_fit.hpp"
@@ -322,6 +324,44 @@ bool prepare_resume(app::SimOptions& o, const tables::PartTables& part, const st
   return true;
 }
 
+// Where this run writes: a new job's own folder (retention first, then the folder made), or for
+// --resume and --replay their journal's folder. The report and the journal land in it unless given;
+// the other outputs when given as bare names. A new job with every output given makes no folder
+// (unless --out-dir asks for one). False with the message: nothing has run.
+bool place_outputs(app::SimOptions& o, std::uint32_t resume_segment, report::JobFolder& folder, std::string& error) {
+  std::string* const side_outputs[] = {&o.trace_path, &o.stock_csv_path, &o.device_log_path, &o.script_csv_path};
+  const bool bare_side_output = std::any_of(std::begin(side_outputs), std::end(side_outputs), [](const std::string* path) {
+    return !path->empty() && path->find('/') == std::string::npos;
+  });
+  std::string report_name = "report.json";
+  if (!o.replay_path.empty() || !o.resume_path.empty()) {
+    folder.use_folder_of(o.replay_path.empty() ? o.resume_path : o.replay_path);
+    report_name = o.replay_path.empty() ? "report-resume-" + std::to_string(resume_segment) + ".json" : "replay.json";
+  } else if (!o.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal) || bare_side_output) {
+    const report::JobFolderRequest request{
+        "stencil-sim",
+        o.out_dir.empty() ? report::default_jobs_folder(o.output_folder, std::getenv("XDG_STATE_HOME"), std::getenv("HOME"))
+                          : o.out_dir,
+        {o.keep_jobs, std::uint64_t{o.keep_mb} * 1'000'000U}};
+    if (!folder.make(request, std::time(nullptr), [](const std::string& line) { std::printf("%s\n", line.c_str()); },
+                     error)) {
+      error = (o.out_dir.empty() ? "" : "--out-dir: ") + error;
+      return false;
+    }
+    std::printf("job folder: %s\n", folder.path().c_str());
+    if (!o.no_journal && o.journal_path.empty()) {
+      o.journal_path = folder.place("", "job.journal");
+    }
+  }
+  if (o.report_path.empty()) {
+    o.report_path = folder.place("", report_name);
+  }
+  for (std::string* path : side_outputs) {
+    *path = folder.place(*path, "");
+  }
+  return true;
+}
+
 // The files a run writes besides its report and journal, closed when the program ends.
 struct SideFiles {
   std::FILE* trace = nullptr;
@@ -403,7 +443,8 @@ board::sim::SimResult run(const app::SimOptions& o, board::sim::SimJob& job) {
 // After the run: the journal ended in order (or, when nothing ran, every output of this run undone),
 // the summary, the report, the picture and the stock's heights. The program's exit status.
 int finish(const app::SimOptions& o, board::sim::SimResult& result, const journal::JobJournalRequest& request,
-           journal::JournalWriter& journal_writer, const std::string& journal_path, const report::Provenance& provenance) {
+           journal::JournalWriter& journal_writer, const std::string& journal_path, const report::Provenance& provenance,
+           report::JobFolder& folder) {
   std::string error;
   if (!result.started) {
     if (!journal::undo_unrun_job_journal(request, journal_writer, journal_path)) {
@@ -412,6 +453,7 @@ int finish(const app::SimOptions& o, board::sim::SimResult& result, const journa
     if (!o.trace_path.empty()) {
       std::remove(o.trace_path.c_str());
     }
+    folder.abandon();
     std::fprintf(stderr, "stencil-sim: %s\n", result.error.c_str());
     return result.error.rfind("--require-rt", 0) == 0 ? kExitBadInput : kExitSafeState;
   }
@@ -450,8 +492,9 @@ int main(int argc, char** argv) {
   CLI::App app{
       "stencil-sim: the haptic stencil controller's cycle and machine side against a simulated operator and\n"
       "device, the fake CY545 stepper controller on a pseudo-terminal and a simulated mill that removes\n"
-      "material; reports gouges, coverage and loop timing. Exit status: 0 done, 2 bad input, 3 ended in a\n"
-      "safe state."};
+      "material; reports gouges, coverage and loop timing. Each job writes in a folder of its own (--out-dir):\n"
+      "its journal, report and picture; a --resume of it writes there too. Exit status: 0 done, 2 bad input\n"
+      "(a jobs folder that cannot be written among it: nothing ran), 3 ended in a safe state."};
   app.set_version_flag("--version", report::version_text("stencil-sim"));
   app::SimOptions o;
   app::add_sim_options(app, o);
@@ -484,22 +527,30 @@ int main(int argc, char** argv) {
   provenance.tables = o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path;
   provenance.tables_crc32 = part.header.crc32;
   provenance.triangle_count = part.header.triangle_count;
+  report::JobFolder folder;
   if (!o.replay_path.empty()) {
-    return replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed, provenance);
+    return place_outputs(o, 0, folder, error)
+               ? replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed, provenance)
+               : bad_input(error);
   }
   journal::JobJournalRequest request;
   request.program = "stencil-sim";
-  request.path = o.journal_path;
-  request.folder = o.output_folder;
   request.none = o.no_journal;
   request.resume_path = o.resume_path;
   request.start.tables_crc32 = part.header.crc32;
   request.start.triangle_count = part.header.triangle_count;
   request.start.job = job_text;
   request.provenance = report::provenance_line(provenance);
-  if (!o.resume_path.empty() && !prepare_resume(o, part, job_text, job, request, error)) {
+  if ((!o.resume_path.empty() && !prepare_resume(o, part, job_text, job, request, error)) ||
+      !place_outputs(o, request.resume.segment, folder, error)) {
     return bad_input(error);
   }
+  request.path = o.journal_path;
+  // From here a refusal undoes the job's folder made for this run (when nothing else is in it).
+  const auto refuse = [&folder](const std::string& message) {
+    folder.abandon();
+    return bad_input(message);
+  };
   job.transport = o.transport == "pio"   ? board::sim::HapticTransport::Pio
                   : o.transport == "can" ? board::sim::HapticTransport::Can
                                          : board::sim::HapticTransport::Direct;
@@ -509,7 +560,7 @@ int main(int argc, char** argv) {
   SideFiles files;
   if ((!o.script_csv_path.empty() && !sim::write_operator_csv(o.script_csv_path, job.script, error)) ||
       !open_trace(o, job, files, error)) {
-    return bad_input(error);
+    return refuse(error);
   }
   if (isatty(STDERR_FILENO) != 0) {
     job.progress = [&job](double t_s, double coverage) {
@@ -521,7 +572,7 @@ int main(int argc, char** argv) {
   journal::JournalWriter journal_writer;
   std::string journal_path;
   if (!check_outputs(o, job, files, error) || !journal::open_job_journal(request, journal_writer, journal_path, error)) {
-    return bad_input(error);
+    return refuse(error);
   }
   if (!journal_path.empty()) {
     job.journal = &journal_writer;
@@ -531,7 +582,9 @@ int main(int argc, char** argv) {
   // The display, before the job: a page opened now sees the job from its start.
   app::Display display;
   if (!display.start(o.display, part, board::sim::controller_config(o.real_time(), job.rig), "stencil-sim", error)) {
-    return bad_input(error);
+    // Nothing ran: no journal of it left behind (an empty job's folder would be kept as resumable).
+    static_cast<void>(journal::undo_unrun_job_journal(request, journal_writer, journal_path));
+    return refuse(error);
   }
   job.display = display.feed();
   job.interrupted = &interrupted;
@@ -545,5 +598,5 @@ int main(int argc, char** argv) {
                    : std::string(", in the safe state (") + control::safe_reason_name(result.safe_state) + ")"));
   display.stop();
   files.close();
-  return finish(o, result, request, journal_writer, journal_path, provenance);
+  return finish(o, result, request, journal_writer, journal_path, provenance, folder);
 }

@@ -81,6 +81,19 @@ TEST(RigConfig, the_shipped_example_equals_the_compiled_in_defaults) {
   CHECK_EQUAL(80, config.cycle_priority);
   CHECK_EQUAL(70, config.machine_priority);
   CHECK_EQUAL(-1, config.cycle_cpu);
+  CHECK_EQUAL(50U, config.keep_jobs);
+  CHECK_EQUAL(0U, config.keep_mb);
+}
+
+TEST(RigConfig, the_retention_of_job_folders_is_taken_and_its_range_held) {
+  RigConfig config;
+  std::string error;
+  std::string text = example_with("keep_jobs", "keep_jobs = 3");
+  text.replace(text.find("keep_mb = 0 "), 12, "keep_mb = 2000 ");
+  CHECK_TEXT(stencil::board::sherline_suzuki::parse_rig_config(text, "rig.toml", config, error), error.c_str());
+  CHECK_EQUAL(3U, config.keep_jobs);
+  CHECK_EQUAL(2000U, config.keep_mb);
+  contains(refusal(example_with("keep_jobs", "keep_jobs = -1")), at_line_of("keep_jobs") + "job.keep_jobs");
 }
 
 TEST(RigConfig, a_changed_fact_is_taken) {

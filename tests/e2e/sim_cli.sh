@@ -410,7 +410,7 @@ case_pio_and_can_give_the_same_result() {
 }
 
 case_trace_is_written() {
-  run_sim --fast --pattern plunge --duration 30 --trace trace.csv --report report.json
+  run_sim --fast --pattern plunge --duration 30 --trace ./trace.csv --report report.json
   expect_status 0
   head -n 1 trace.csv | grep -qx 't_s,x_mm,y_mm,z_mm' || fail "trace.csv has no header t_s,x_mm,y_mm,z_mm"
   [ "$(wc -l <trace.csv)" -gt 10 ] || fail "trace.csv has fewer than 10 corners"
@@ -449,7 +449,8 @@ case_speed_n_is_fast_mode_paced() {
 }
 
 # --journal: every cycle's record and every machine command reach the file; a journal that cannot
-# be created is refused before the run. Without --journal the journal is named after the start time.
+# be created is refused before the run. Without --journal the journal is job.journal in the job's own
+# folder, named after the start time, under $XDG_STATE_HOME/stencil/jobs.
 case_journal_holds_every_cycle() {
   run_sim --fast --pattern plunge --duration 5 --journal job.journal --report report.json
   expect_status 0
@@ -468,7 +469,8 @@ case_journal_holds_every_cycle() {
   expect_status 0
   local named
   named=$(sed -n 's/^journal: //p' stdout.txt)
-  echo "$named" | grep -Eq '^stencil-sim-[0-9]{8}-[0-9]{6}[.]journal$' || fail "the default journal is '$named'; expected stencil-sim-YYYYMMDD-HHMMSS.journal"
+  echo "$named" | grep -Eq "^$XDG_STATE_HOME/stencil/jobs/stencil-sim-[0-9]{8}-[0-9]{6}/job[.]journal\$" ||
+    fail "the default journal is '$named'; expected \$XDG_STATE_HOME/stencil/jobs/stencil-sim-YYYYMMDD-HHMMSS/job.journal"
   [ -s "$named" ] || fail "the default journal $named was not written"
   run_sim --fast --pattern plunge --duration 1 --no-journal --report report4.json
   expect_status 0
@@ -536,7 +538,7 @@ shared="$work_root/shared"
 case_reference_job() {
   mkdir -p "$shared"
   rm -f "$shared/reference.csv"
-  run_sim "${fault_job[@]}" --no-journal --report report.json --stock-csv reference.csv
+  run_sim "${fault_job[@]}" --no-journal --report report.json --stock-csv ./reference.csv
   expect_status 0
   no_gouge
   local removed
@@ -617,7 +619,7 @@ case_fault_overrun_storm() { expect_fault overrun-storm overrun_storm 0.004; }
 # 20 ms, and a few on this host). Then --resume from the journal: a torn tail, if the kill left one,
 # is ignored, and the job carries on to the same stock as the uninterrupted run.
 case_kill_mid_cut_then_resume() {
-  local paced=(--speed 10 "${fault_job[@]:1}" --haptic-transport pio --device-process device.log)
+  local paced=(--speed 10 "${fault_job[@]:1}" --haptic-transport pio --device-process ./device.log)
   echo "\$ stencil-sim ${paced[*]} --journal job.journal --report report.json  (SIGKILL once cutting)"
   "$sim" "${paced[@]}" --journal job.journal --report report.json >stdout.txt 2>stderr.txt &
   local pid=$! waited=0 zero_ms
@@ -648,7 +650,7 @@ case_kill_mid_cut_then_resume() {
 # Garbage on the serial line between exchanges: the driver flushes its input before each query,
 # so the bytes are dropped and the job goes on, ungouged.
 case_fault_serial_garbage_is_flushed() {
-  run_sim "${fault_job[@]}" --inject serial-garbage@40 --report report.json --stock-csv stock.csv
+  run_sim "${fault_job[@]}" --inject serial-garbage@40 --report report.json --stock-csv ./stock.csv
   expect_status 0
   no_gouge
   grep -q '"kind": "serial-garbage"' report.json || fail "the report does not name the injected fault"
@@ -945,12 +947,89 @@ case_rig_without_the_hardware_fails_cleanly() {
   expect_stderr "/nonexistent/rig.json: cannot be written" "the report that cannot be written, before anything opens"
 }
 
+# Job folders (issue 25): a job and its --resume write in one folder of their own, under
+# $XDG_STATE_HOME/stencil/jobs by default, and nothing in the current folder; `latest` is that folder.
+short_job=(--fast --pattern plunge --duration 2)
+case_job_and_its_resume_share_one_folder() {
+  run_sim "${short_job[@]}" --inject pose-jump@1
+  expect_status 3
+  local folder
+  folder=$(sed -n 's/^job folder: //p' stdout.txt)
+  echo "$folder" | grep -Eq "^$XDG_STATE_HOME/stencil/jobs/stencil-sim-[0-9]{8}-[0-9]{6}\$" ||
+    fail "the job's folder is '$folder'; expected \$XDG_STATE_HOME/stencil/jobs/stencil-sim-YYYYMMDD-HHMMSS"
+  [ "$(readlink "$XDG_STATE_HOME/stencil/jobs/latest")" = "$(basename "$folder")" ] || fail "latest does not point at $folder"
+  run_sim "${short_job[@]}" --resume "$XDG_STATE_HOME/stencil/jobs/latest/job.journal"
+  expect_status 0
+  grep -q "^report: $XDG_STATE_HOME/stencil/jobs/latest/report-resume-1.json" stdout.txt ||
+    fail "the resume's report is not report-resume-1.json in the job's folder"
+  local file
+  for file in job.journal report.json report-resume-1.json; do
+    [ -s "$folder/$file" ] || fail "$folder has no $file"
+  done
+  [ "$(find "$folder" -name 'report-resume-1.*' ! -name '*.json' | wc -l)" = 1 ] || fail "no picture beside report-resume-1.json"
+  [ "$(json_number "$folder/report-resume-1.json" runs)" = 2 ] || fail "the resume's report does not cover both runs"
+  [ "$(find "$XDG_STATE_HOME/stencil/jobs" -mindepth 1 -maxdepth 1 | wc -l)" = 2 ] || fail "more than one job's folder and latest"
+  local here
+  here=$(ls -A | grep -v -x -e stdout.txt -e stderr.txt -e xdg-state)
+  [ -z "$here" ] || fail "the jobs wrote in the current folder: $here"
+}
+
+# Retention (--keep-jobs 2, this job counted): the oldest finished job is removed as a new one
+# starts, and a killed one (its journal has no End: it may be resumed) is kept, each said.
+case_retention_keeps_an_interrupted_job() {
+  local kept=(--out-dir jobs --keep-jobs 2) first interrupted second
+  run_sim "${short_job[@]}" "${kept[@]}"
+  expect_status 0
+  first=$(sed -n 's/^job folder: //p' stdout.txt)
+  echo "\$ stencil-sim --speed 5 --pattern raster --duration 600 ${kept[*]}  (SIGKILL once its journal is open)"
+  "$sim" --speed 5 --pattern raster --duration 600 "${kept[@]}" >killed.txt 2>&1 &
+  local pid=$! waited=0
+  while ! grep -q '^journal: ' killed.txt 2>/dev/null && [ "$waited" -lt 600 ]; do
+    sleep 0.05
+    waited=$((waited + 1))
+  done
+  kill -KILL "$pid"
+  wait "$pid"
+  interrupted=$(sed -n 's/^job folder: //p' killed.txt)
+  [ -n "$interrupted" ] || fail "the killed job said no folder: $(cat killed.txt)"
+  run_sim "${short_job[@]}" "${kept[@]}"
+  expect_status 0
+  second=$(sed -n 's/^job folder: //p' stdout.txt)
+  grep -q "^jobs: removed $first (finished, [0-9.]* MB)\$" stdout.txt || fail "the third job did not say it removed $first"
+  [ ! -e "$first" ] || fail "the oldest finished job $first is still there"
+  run_sim "${short_job[@]}" "${kept[@]}"
+  expect_status 0
+  grep -q "^jobs: kept $interrupted: interrupted, may be resumed\$" stdout.txt || fail "the fourth job did not say it kept $interrupted"
+  [ -s "$interrupted/job.journal" ] || fail "the interrupted job $interrupted was removed"
+  [ -s "$second/report.json" ] || fail "the newest finished job but this one, $second, was removed"
+  [ "$(readlink jobs/latest)" = "$(sed -n 's/^job folder: jobs\///p' stdout.txt)" ] || fail "latest is not the newest job"
+}
+
+# A jobs folder that cannot be made or written in is refused before the job starts (exit 2), naming
+# the folder and why, whether --out-dir or $XDG_STATE_HOME gives it; no job ran, no report anywhere.
+case_refuses_an_out_dir_it_cannot_write() {
+  : >a_file
+  run_sim "${short_job[@]}" --out-dir a_file/jobs
+  expect_status 2
+  expect_stderr "--out-dir: a_file/jobs: the jobs folder cannot be created: Not a directory" "the folder and why"
+  ! grep -q "^stencil-sim: the baked-in" stdout.txt || fail "the job started"
+  XDG_STATE_HOME="$PWD/a_file" run_sim "${short_job[@]}"
+  expect_status 2
+  expect_stderr "$PWD/a_file/stencil/jobs: the jobs folder cannot be created: Not a directory" "the default folder and why"
+  [ -z "$(find . -name '*.json' -o -name '*.journal')" ] || fail "a refused job left a report or a journal"
+  run_sim "${short_job[@]}" --resume job.journal --out-dir jobs
+  expect_status 2
+  expect_stderr "--out-dir: a --resume or a --replay writes in its journal's folder" "that --out-dir has no place in a resume"
+}
+
 if ! declare -F "case_$case_name" >/dev/null; then
   echo "sim_cli.sh: no case '$case_name'" >&2
   exit 2
 fi
 work="$work_root/sim_$case_name"
 rm -rf "$work" && mkdir -p "$work" && cd "$work" || exit 1
+# Jobs with no --out-dir make their folders under $XDG_STATE_HOME/stencil/jobs: the case's own.
+export XDG_STATE_HOME="$work/xdg-state"
 "case_$case_name"
 if [ "$failures" -gt 0 ]; then
   echo "$failures failure(s); the case's files are in $work" >&2
