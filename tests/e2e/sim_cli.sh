@@ -275,6 +275,7 @@ case_same_report_twice() {
   if ! diff <(strip_wall_clock first.json) <(strip_wall_clock second.json); then
     fail "two runs of the same job gave different reports"
   fi
+  cmp -s first.png second.png || fail "two runs of the same job gave different pictures"
 }
 
 # A display killed part way through a job changes nothing in it: the controller neither waits for
