@@ -53,7 +53,7 @@ std::vector<Rgb> cell_colours(const SimResult& r) {
   }
   std::vector<Rgb> colours(r.stock_heights.size());
   for (std::size_t i = 0; i < colours.size(); ++i) {
-    const double distance = r.signed_distance_mm[i];
+    const auto distance = static_cast<double>(r.signed_distance_mm[i]);
     const double left = i < r.unmachined_heights.size() ? r.unmachined_heights[i] : 0.0;
     if (distance < -kGougeToleranceMm) {
       colours[i] = kGouge;

@@ -22,7 +22,7 @@ std::vector<Triangle> triangles_of(const tables::PartTables& part) {
     Triangle triangle;
     for (std::size_t i = 0; i < 3; ++i) {
       const tables::PackedPoint& v = part.triangles[t].vertices[i];
-      triangle[i] = {v.x_mm, v.y_mm, v.z_mm};
+      triangle[i] = {static_cast<double>(v.x_mm), static_cast<double>(v.y_mm), static_cast<double>(v.z_mm)};
     }
     triangles.push_back(triangle);
   }
