@@ -40,6 +40,7 @@ packages=(
   libcli11-dev       # the table generator's command line
   libtomlplusplus-dev  # the rig's configuration file (header-only)
   nlohmann-json3-dev # --inspect --json
+  libpng-dev         # stencil-sim's picture of the machined stock (PNG)
   libfcl-dev         # stencil-bench compares the engine with the Flexible Collision Library
   clang              # the fuzz preset's compiler (libFuzzer needs clang)
   libclang-rt-14-dev # libFuzzer and the sanitizer runtimes for clang 14 (only recommended by clang)

@@ -8,7 +8,7 @@
 #   journals (*.journal)  equal apart from the start times in the Start and Resume records and those
 #                         records' CRC-32s; journals named after their start time
 #                         (stencil-sim-YYYYMMDD-HHMMSS.journal) are paired in the order of their names
-#   stocks, traces (*.csv) and pictures (*.svg): byte for byte
+#   stocks, traces (*.csv) and pictures (*.png; *.svg before issue 25): byte for byte
 #   the runs              each command, its exit status and what it wrote on stderr
 # A file on one side only, a journal that cannot be read, a case that wrote nothing: all fail.
 #
@@ -165,7 +165,7 @@ run_jobs new "$new_build/bin/stencil-sim"
 # is taken as the case's folder with the names builds before job folders gave: its job.journal as a
 # journal named after its start time, report.json and its picture as stencil-sim-report.*.
 outputs() {
-  (cd "$1" && find . -type f \( -name '*.json' -o -name '*.journal' -o -name '*.csv' -o -name '*.svg' \) | sed 's|^\./||' | LC_ALL=C sort) |
+  (cd "$1" && find . -type f \( -name '*.json' -o -name '*.journal' -o -name '*.csv' -o -name '*.png' -o -name '*.svg' \) | sed 's|^\./||' | LC_ALL=C sort) |
     awk '{
       n = split($0, parts, "/")
       folder = substr($0, 1, length($0) - length(parts[n]))

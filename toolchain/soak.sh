@@ -17,7 +17,7 @@ if [ "$#" -ne 5 ]; then
 fi
 sim=$(realpath "$1") out=$2 hours=$3 faults=$4 seed=$5
 mkdir -p "$out" && cd "$out" || exit 2
-rm -f soak.journal run-*.json run-*.svg run-*.txt
+rm -f soak.journal run-*.json run-*.png run-*.svg run-*.txt
 RANDOM=$seed
 
 total_s=$(awk -v h="$hours" 'BEGIN { printf "%d", h * 3600 }')

@@ -143,7 +143,14 @@ struct SimResult {
   double cell_mm = 0.0;
   std::vector<double> stock_heights, part_heights;
   std::vector<double> unmachined_heights;  // stock this tool could still remove over each cell, mm thick
+  // From each cell's top (its centre at its stock height) to the part's surface, mm: negative inside
+  // the part, exact within kSignedDistanceReachMm and clamped to it beyond (the picture's colours).
+  std::vector<float> signed_distance_mm;
 };
+
+// How far the signed distances of the stock's cells are exact (mm): as far as the picture's blue
+// scale of stock left goes; farther cells are clamped to it, which keeps the end of a job quick.
+inline constexpr double kSignedDistanceReachMm = 2.0;
 
 // Runs the job on virtual time, as fast as the machine allows; the same job gives the same result
 // apart from the wall-clock fields (compute_us, wall_s).

@@ -1,8 +1,6 @@
-// Report, summary and picture of a simulated job.
+// Report and summary of a simulated job.
 #include "board/sim/sim_report.hpp"
 
-#include <algorithm>
-#include <cmath>
 #include <cstdio>
 
 #include <nlohmann/json.hpp>
@@ -147,71 +145,6 @@ std::string summary(const SimResult& r) {
                                   : "; the watchdog relay dropped them a second later\n");
   }
   return out;
-}
-
-bool write_picture_svg(const std::string& path, const SimResult& r, std::string& error) {
-  // Blocks of cells, so the picture stays small: at most about 200 blocks across.
-  const int block = std::max(1, std::max(r.columns, r.rows) / 200);
-  const int columns = (r.columns + block - 1) / block, rows = (r.rows + block - 1) / block;
-  const double size = 4.0;  // px per block
-  double low = 1e300, high = -1e300;
-  for (const double h : r.stock_heights) {
-    low = std::min(low, h);
-    high = std::max(high, h);
-  }
-  for (const double h : r.part_heights) {
-    high = std::max(high, h);
-  }
-  const double span = high > low ? high - low : 1.0;
-  std::FILE* out = std::fopen(path.c_str(), "w");
-  if (out == nullptr) {
-    error = path + ": cannot be written";
-    return false;
-  }
-  const double width = 2.0 * columns * size + 3.0 * 10.0;
-  const double height = rows * size + 40.0;
-  std::fprintf(out, "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" font-family=\"sans-serif\" font-size=\"12\">\n",
-               width, height);
-  std::fprintf(out, "<rect width=\"100%%\" height=\"100%%\" fill=\"white\"/>\n");
-  std::fprintf(out, "<text x=\"10\" y=\"16\">stock as machined (darker is lower; red: cut below the part; blue: left that this tool could remove)</text>\n");
-  std::fprintf(out, "<text x=\"%.0f\" y=\"16\">the part's top</text>\n", 20.0 + columns * size);
-  for (int panel = 0; panel < 2; ++panel) {
-    const std::vector<double>& grid = panel == 0 ? r.stock_heights : r.part_heights;
-    const double x0 = 10.0 + panel * (columns * size + 10.0);
-    for (int br = 0; br < rows; ++br) {
-      for (int bc = 0; bc < columns; ++bc) {
-        double value = -1e300, gouge = 0.0, left = 0.0;
-        for (int row = br * block; row < std::min(r.rows, (br + 1) * block); ++row) {
-          for (int column = bc * block; column < std::min(r.columns, (bc + 1) * block); ++column) {
-            const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(r.columns) +
-                                  static_cast<std::size_t>(column);
-            value = std::max(value, grid[i]);
-            gouge = std::max(gouge, r.part_heights[i] - r.stock_heights[i]);
-            if (i < r.unmachined_heights.size()) {
-              left = std::max(left, r.unmachined_heights[i]);
-            }
-          }
-        }
-        const int grey = static_cast<int>(40.0 + 200.0 * std::clamp((value - low) / span, 0.0, 1.0));
-        const bool warn = panel == 0 && gouge > 0.005;
-        // More than a hundredth of a millimetre left is shown, deeper blue for more (full at 0.5 mm).
-        const bool unmachined = panel == 0 && !warn && left > 0.01;
-        const int shade = static_cast<int>(200.0 * (1.0 - std::clamp(left / 0.5, 0.0, 1.0)));
-        // Rows run up the picture as y runs up the world.
-        std::fprintf(out, "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"%s\"/>\n", x0 + bc * size,
-                     30.0 + (rows - 1 - br) * size, size, size,
-                     warn         ? "#e0201c"
-                     : unmachined ? ("rgb(" + std::to_string(shade) + "," + std::to_string(shade) + ",255)").c_str()
-                                  : ("rgb(" + std::to_string(grey) + "," + std::to_string(grey) + "," + std::to_string(grey) + ")").c_str());
-      }
-    }
-  }
-  std::fprintf(out, "</svg>\n");
-  if (std::fclose(out) != 0) {
-    error = path + ": cannot be written";
-    return false;
-  }
-  return true;
 }
 
 }  // namespace stencil::board::sim

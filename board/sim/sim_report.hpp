@@ -1,10 +1,11 @@
-// The simulation's report: JSON for machines, a summary for people, and a picture of the machined
-// stock beside the part with gouges in a warning colour.
+// The simulation's report: JSON for machines, a summary for people, and the stock's heights as CSV;
+// the picture that goes beside the report is stock_picture.hpp's, included here for the programs.
 #pragma once
 
 #include <string>
 
 #include "board/sim/sim_job.hpp"
+#include "board/sim/stock_picture.hpp"
 #include "firmware/services/report/provenance.hpp"
 
 namespace stencil::board::sim {
@@ -18,9 +19,5 @@ namespace stencil::board::sim {
 
 // A few lines for the terminal.
 [[nodiscard]] std::string summary(const SimResult& result);
-
-// Top views side by side, as SVG: the stock as machined (darker is lower), the part's top, and
-// every cell cut below the part's surface by more than 5 um in red.
-[[nodiscard]] bool write_picture_svg(const std::string& path, const SimResult& result, std::string& error);
 
 }  // namespace stencil::board::sim

@@ -74,6 +74,7 @@ void fill_stock(SimResult& result, const control::CommandedStock& model, const s
   }
   result.part_heights = machined.part_heights();
   result.unmachined_heights = std::move(volumes.unmachined_per_cell_mm);
+  result.signed_distance_mm = machined.signed_distances(result.part_heights, kSignedDistanceReachMm);
   result.model_removed_volume_mm3 = model.removed_volume_mm3();
   for (int row = 0; row < model.rows(); ++row) {
     for (int column = 0; column < model.columns(); ++column) {

@@ -88,12 +88,12 @@ bool parse_stock(const std::string& text, const tables::PartTables& part, sim::S
   return true;
 }
 
-// The picture goes beside the report, as .svg.
+// The picture goes beside the report, as .png.
 std::string picture_path_of(const std::string& report_path) {
   return (report_path.size() > 5 && report_path.compare(report_path.size() - 5, 5, ".json") == 0
               ? report_path.substr(0, report_path.size() - 5)
               : report_path) +
-         ".svg";
+         ".png";
 }
 
 // One run of a journal (0: the first, 1 the first resume, ...): its cycles and the commands they took.
@@ -194,7 +194,7 @@ int replay(const std::string& path, const tables::PartTables& part, board::sim::
   }
   std::printf("%s", board::sim::summary(result).c_str());
   const std::string picture_path = picture_path_of(report_path);
-  if (!board::sim::write_report_json(report_path, result, provenance, error) || !board::sim::write_picture_svg(picture_path, result, error) ||
+  if (!board::sim::write_report_json(report_path, result, provenance, error) || !board::sim::write_picture_png(picture_path, result, error) ||
       (!stock_csv_path.empty() && !board::sim::write_stock_csv(stock_csv_path, result, error))) {
     return bad_input(error);
   }
@@ -470,7 +470,7 @@ int finish(const app::SimOptions& o, board::sim::SimResult& result, const journa
   std::printf("%s", board::sim::summary(result).c_str());
   const std::string picture_path = picture_path_of(o.report_path);
   if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
-      !board::sim::write_picture_svg(picture_path, result, error) ||
+      !board::sim::write_picture_png(picture_path, result, error) ||
       (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
     return bad_input(error);
   }

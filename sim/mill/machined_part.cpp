@@ -6,6 +6,7 @@
 #include <limits>
 #include <utility>
 
+#include "sim/mill/surface_distance.hpp"
 #include "sim/mill/triangle_distance.hpp"
 
 namespace stencil::sim {
@@ -216,6 +217,19 @@ std::vector<double> part_top_heights(const tables::PartTables& part, const Stock
 }
 
 std::vector<double> MachinedPart::part_heights() const { return part_top_heights(part_, stock_); }
+
+std::vector<float> MachinedPart::signed_distances(const std::vector<double>& part_heights, double reach_mm) const {
+  std::vector<double> heights;
+  heights.reserve(part_heights.size());
+  for (int row = 0; row < stock_.rows(); ++row) {
+    for (int column = 0; column < stock_.columns(); ++column) {
+      heights.push_back(stock_.height(column, row));
+    }
+  }
+  const SurfaceDistance surface(triangles_of(part_), reach_mm);
+  const CellGrid grid{stock_.columns(), stock_.rows(), stock_.cell_mm(), stock_.box().low_mm.head<2>()};
+  return sim::signed_distances(surface, grid, heights, part_heights);
+}
 
 std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& part, double allowance_mm) const {
   const int columns = stock_.columns(), rows = stock_.rows();

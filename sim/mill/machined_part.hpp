@@ -81,6 +81,9 @@ class MachinedPart final : public MillMotionObserver {
   };
   [[nodiscard]] Volumes volumes() const;
   [[nodiscard]] std::vector<double> part_heights() const;
+  // Over each cell of the stock, the signed distance from its top to the part's triangles, given
+  // the part's top over each (part_heights()), exact within `reach_mm` (surface_distance.hpp).
+  [[nodiscard]] std::vector<float> signed_distances(const std::vector<double>& part_heights, double reach_mm) const;
   [[nodiscard]] const ToolProfile& tool() const { return tool_; }
 
  private:

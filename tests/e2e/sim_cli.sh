@@ -101,6 +101,12 @@ stock_within() {
   at_most "$worst" "$3" "$4: the largest difference of any stock cell from the uninterrupted run's (mm)"
 }
 
+# is_png FILE: the picture beside the report is there and starts with PNG's signature.
+is_png() {
+  [ -s "$1" ] || fail "no picture was written beside the report ($1)"
+  [ "$(head -c 8 "$1" | od -An -tx1 | tr -d ' \n')" = 89504e470d0a1a0a ] || fail "$1 is not a PNG picture"
+}
+
 no_gouge() {
   at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
   grep -q '"safe_state": null' report.json || fail "the run ended in a safe state: $(grep safe_state report.json)"
@@ -115,8 +121,7 @@ case_raster_whole_part() {
   no_gouge
   at_most "$(json_number report.json fraction)" 0.01 "the unmachined fraction"
   grep -q '"complete": true' report.json || fail "the job did not complete"
-  [ -s report.svg ] || fail "no picture was written beside the report"
-  grep -q '<svg' report.svg || fail "report.svg is not an SVG picture"
+  is_png report.png
 }
 
 # A corner of the hex prism's stock, raster until done: the same bar on a quarter of the job,
@@ -128,8 +133,7 @@ case_raster_corner() {
   at_most "$(json_number report.json fraction)" 0.01 "the unmachined fraction"
   # The controller's own model of the stock (from what it commanded) agrees with the mill's.
   at_most "$(json_number report.json max_difference_mm)" 0.01 "the model's largest difference from the mill's stock (mm)"
-  [ -s report.svg ] || fail "no picture was written beside the report"
-  grep -q '<svg' report.svg || fail "report.svg is not an SVG picture"
+  is_png report.png
 }
 
 # The corner job stopped by a fault half-way (its tool in contact with the part by then), resumed
@@ -279,6 +283,7 @@ case_same_report_twice() {
   if ! diff <(strip_wall_clock first.json) <(strip_wall_clock second.json); then
     fail "two runs of the same job gave different reports"
   fi
+  cmp -s first.png second.png || fail "two runs of the same job gave different pictures"
 }
 
 # A display killed part way through a job changes nothing in it: the controller neither waits for

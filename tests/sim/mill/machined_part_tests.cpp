@@ -116,3 +116,28 @@ TEST(MachinedPart, ALegClearOfThePartIsNoGouge) {
   DOUBLES_EQUAL(0.0, machined.max_gouge_mm(), 0.0);
   LONGS_EQUAL(3, machined.legs());
 }
+
+TEST(MachinedPart, EachCellsSignedDistanceIsFromItsTopToThePrismsSurface) {
+  PrismJob job;
+  MachinedPart& machined = *job.machined;
+  const auto at = &PrismJob::at;
+  // The leg that gouges the prism's top by 0.25 mm (above), from x = 0 to its middle.
+  machined.axis_moved(Axis::y, at(0.0, 12.5, 0.0));
+  machined.axis_moved(Axis::z, at(0.0, 12.5, 5.75));
+  machined.axis_moved(Axis::x, at(25.0, 12.5, 5.75));
+  machined.flush();
+  const StockZmap& stock = machined.stock();
+  const std::vector<float> distance = machined.signed_distances(machined.part_heights(), 2.0);
+  LONGS_EQUAL(static_cast<long>(stock.columns()) * stock.rows(), static_cast<long>(distance.size()));
+  const auto cell = [&](double x, double y) {
+    const int column = static_cast<int>((x - 15.0) / stock.cell_mm()), row = static_cast<int>((y - 3.0) / stock.cell_mm());
+    return distance[static_cast<std::size_t>(row) * static_cast<std::size_t>(stock.columns()) + static_cast<std::size_t>(column)];
+  };
+  // Untouched over the prism's top (z = 6): the stock's top 1 mm above it.
+  DOUBLES_EQUAL(1.0, cell(26.0, 16.0), 1e-4);
+  // Under the leg, 3 mm inside the prism's side: 0.25 mm under its top (the ball's centre line is
+  // 0.2 um off the cell's centre).
+  DOUBLES_EQUAL(-0.25, cell(20.0, 12.5), 1e-3);
+  // The stock's corner, farther than the reach from the prism: clamped to it.
+  DOUBLES_EQUAL(2.0, cell(15.1, 3.1), 0.0);
+}
