@@ -1,6 +1,8 @@
 // A recorded run, cycle by cycle.
 #include "board/sim/journal_replay.hpp"
 
+#include <cstring>
+
 #include "firmware/core/control/safe_state.hpp"
 
 namespace stencil::board::sim {
@@ -35,10 +37,9 @@ void JournalReplay::after_cycle(const runtime::CycleTime& /*time*/, control::Cyc
   const Eigen::Vector3d tip = controller_.virtual_tip_mm();
   const control::JournalRecord& recorded = recorded_->record;
   const double replayed[3] = {tip.x(), tip.y(), tip.z()};
-  const bool same = recorded_->tool_recorded
-                        ? tip.x() == recorded.virtual_tip_mm[0] && tip.y() == recorded.virtual_tip_mm[1] &&
-                              tip.z() == recorded.virtual_tip_mm[2]
-                        : journal::tip_check(replayed) == recorded_->tip_check;
+  // Bit for bit where the tip was kept (-0 is not +0, a NaN is itself), else its CRC-32.
+  const bool same = recorded_->tool_recorded ? std::memcmp(replayed, recorded.virtual_tip_mm, sizeof replayed) == 0
+                                             : journal::tip_check(replayed) == recorded_->tip_check;
   if (!same && mismatches_++ == 0) {
     first_mismatch_ = static_cast<std::int64_t>(recorded.cycle);
   }

@@ -45,20 +45,33 @@ void print_summary(const std::string& path, const Counts& c, const journal::Jour
   }
 }
 
-// One line of JSON per cycle: what the cycle read and left (the tip null where only its check was kept).
+// Three numbers as a JSON array; one that is not finite (a device that sent NaN) as null.
+std::string json_array(double a, double b, double c, const char* format) {
+  std::string text = "[";
+  for (const double v : {a, b, c}) {
+    char number[40] = "null";
+    if (std::isfinite(v)) {
+      std::snprintf(number, sizeof number, format, v);
+    }
+    text.append(text.size() > 1 ? ", " : "").append(number);
+  }
+  return text.append("]");
+}
+
+// One line of JSON per cycle: what the cycle read and left (tip and force null where the journal kept
+// only the tip's check: tool_kept false).
 void print_cycle(const journal::RecordedCycle& cycle) {
   const control::JournalRecord& r = cycle.record;
-  std::printf("{\"cycle\": %" PRIu64 ", \"time_ns\": %" PRId64 ", \"device_mm\": [%.17g, %.17g, %.17g], \"fresh\": %s, ",
-              r.cycle, r.time_ns, r.device_mm[0], r.device_mm[1], r.device_mm[2], r.fresh ? "true" : "false");
-  if (cycle.tool_recorded && std::isfinite(r.virtual_tip_mm[0])) {
-    std::printf("\"tip_mm\": [%.17g, %.17g, %.17g], \"force_n\": [%.9g, %.9g, %.9g], ", r.virtual_tip_mm[0],
-                r.virtual_tip_mm[1], r.virtual_tip_mm[2], static_cast<double>(r.force_n[0]), static_cast<double>(r.force_n[1]),
-                static_cast<double>(r.force_n[2]));
-  } else {
-    std::printf("\"tip_mm\": null, \"force_n\": null, ");
-  }
-  std::printf("\"tip_check\": %" PRIu32 ", \"touched\": %" PRIu32 ", \"safe_state\": \"%s\"}\n", cycle.tip_check,
-              r.touched_triangles, control::safe_reason_name(r.safe_reason));
+  const std::string device = json_array(r.device_mm[0], r.device_mm[1], r.device_mm[2], "%.17g");
+  const std::string tip = cycle.tool_recorded ? json_array(r.virtual_tip_mm[0], r.virtual_tip_mm[1], r.virtual_tip_mm[2], "%.17g")
+                                              : "null";
+  const std::string force = cycle.tool_recorded ? json_array(static_cast<double>(r.force_n[0]), static_cast<double>(r.force_n[1]),
+                                                             static_cast<double>(r.force_n[2]), "%.9g")
+                                                : "null";
+  std::printf("{\"cycle\": %" PRIu64 ", \"time_ns\": %" PRId64 ", \"device_mm\": %s, \"fresh\": %s, \"tool_kept\": %s, "
+              "\"tip_mm\": %s, \"force_n\": %s, \"tip_check\": %" PRIu32 ", \"touched\": %" PRIu32 ", \"safe_state\": \"%s\"}\n",
+              r.cycle, r.time_ns, device.c_str(), r.fresh ? "true" : "false", cycle.tool_recorded ? "true" : "false",
+              tip.c_str(), force.c_str(), cycle.tip_check, r.touched_triangles, control::safe_reason_name(r.safe_reason));
 }
 
 int read(const std::string& path, bool cycles_json) {

@@ -402,23 +402,28 @@ TEST(Journal, ResumingCutsTheTornTailAndCarriesOnInTheSameFile) {
   resume.approach_s = 40.25;
   resume.program = "stencil-sim";
   CHECK_TRUE(writer.open_to_resume(file.path, first.good_bytes, resume));
-  CHECK_TRUE(writer.append(record_of(0)));
-  CHECK_TRUE(writer.append_end(1, SafeReason::None));
+  for (std::uint64_t c = 0; c < 5; ++c) {
+    CHECK_TRUE(writer.append(record_of(c)));
+  }
+  CHECK_TRUE(writer.append_end(5, SafeReason::None));
   CHECK_TRUE(writer.close());
   Seen after;
   const JournalReadResult second = read_journal_file(file.path, after.visitor());
   CHECK_TRUE(second.ok);
   LONGS_EQUAL(0, second.tail_bytes);
-  LONGS_EQUAL(101, after.cycles.size());
-  CHECK_TRUE(after.cycles.back().tool_recorded);  // a run's first cycle is a key: nothing before it needed
+  LONGS_EQUAL(105, after.cycles.size());
+  // The resumed run reads as written, its times among them (its steps count afresh, as its writer's).
+  CHECK_TRUE(after.cycles[100].tool_recorded);  // a run's first cycle is a key: nothing before it needed
+  for (std::uint64_t c = 0; c < 5; ++c) {
+    check_same(record_of(c), after.cycles[100 + c]);
+  }
   LONGS_EQUAL(1, after.resumes.size());
   LONGS_EQUAL(1, after.resumes[0].segment);
   LONGS_EQUAL(77, after.resumes[0].unix_time_ns);
   CHECK(after.resumes[0].script_s == 12.5 && after.resumes[0].approach_s == 40.25);
   STRCMP_EQUAL("stencil-sim", after.resumes[0].program.c_str());
-  LONGS_EQUAL(0, after.cycles.back().record.cycle);
   LONGS_EQUAL(1, after.endings.size());  // the first run was cut off: only the second ended in order
-  LONGS_EQUAL(1, after.endings[0].first);
+  LONGS_EQUAL(5, after.endings[0].first);
   CHECK(after.endings[0].second == SafeReason::None);
 }
 
@@ -650,6 +655,34 @@ TEST(Journal, EachRunSaysWhatMadeItAndAVersion3JournalIsCarriedOnAsVersion5) {
   read = read_journal(short_text.data(), short_text.size(), wrong.visitor());
   CHECK_FALSE(read.ok);
   STRCMP_CONTAINS("a provenance record of 9 bytes that does not hold its text", read.error.c_str());
+}
+
+// A run's cycles are all in one form; a Cycles record holds at least one. Anything else is damage.
+TEST(Journal, ARunOfCompactCyclesWithAWholeCycleRecordOrAnEmptyCyclesRecordIsAnErrorNamingTheOffset) {
+  TempJournal file;
+  write_job(file.path, 3);
+  const std::vector<std::uint8_t> whole = file.bytes();
+  const auto appended = [&](RecordType type, const ByteWriter& payload) {
+    ByteWriter record;
+    record.u32(static_cast<std::uint32_t>(payload.size()));
+    record.u8(static_cast<std::uint8_t>(type));
+    record.bytes(payload.data(), payload.size());
+    record.u32(static_cast<std::uint32_t>(crc32(crc32(0L, Z_NULL, 0), record.data(), static_cast<uInt>(record.size()))));
+    std::vector<std::uint8_t> bytes = whole;
+    bytes.insert(bytes.end(), record.data(), record.data() + record.size());
+    return bytes;
+  };
+  ByteWriter cycle;
+  encode_cycle(record_of(3), cycle);
+  std::vector<std::uint8_t> bytes = appended(RecordType::Cycle, cycle);
+  JournalReadResult read = read_journal(bytes.data(), bytes.size(), {});
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS(("journal offset " + std::to_string(whole.size()) + ": a cycle record of 106 bytes in a run of compact cycles").c_str(),
+                  read.error.c_str());
+  bytes = appended(RecordType::Cycles, ByteWriter{});
+  read = read_journal(bytes.data(), bytes.size(), {});
+  CHECK_FALSE(read.ok);
+  STRCMP_CONTAINS("an empty cycles record (expected at least one cycle)", read.error.c_str());
 }
 
 TEST(Journal, ACommandRecordOutOfRangeIsAnErrorNamingTheOffset) {

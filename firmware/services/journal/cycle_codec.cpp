@@ -21,6 +21,7 @@ constexpr std::uint8_t kAnglesFollow = 0x40;
 constexpr int kFields = 5;
 constexpr double kStepsPerUnit[kFields] = {1e3, 1e3, 1e3, 1e6, 1e6};
 constexpr double kUnitPerStep[kFields] = {1e-3, 1e-3, 1e-3, 1e-6, 1e-6};
+constexpr const char* kFieldName[kFields] = {"device x", "device y", "device z", "angle 0", "angle 1"};
 // Steps beyond this are not counted (the doubles stay exact well inside it, and no device reaches it).
 constexpr double kMostSteps = 4.0e15;
 
@@ -79,12 +80,17 @@ void read_tool(ByteReader& in, control::JournalRecord& r) {
 
 }  // namespace
 
+// On the stack: a replay computes it in its cycle's hook, where nothing allocates.
 std::uint32_t tip_check(const double tip_mm[3]) {
-  ByteWriter bytes;
+  std::uint8_t bytes[24];
   for (int i = 0; i < 3; ++i) {
-    bytes.f64(tip_mm[i]);
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &tip_mm[i], sizeof bits);
+    for (int b = 0; b < 8; ++b) {
+      bytes[8 * i + b] = static_cast<std::uint8_t>(bits >> (8 * b));
+    }
   }
-  return static_cast<std::uint32_t>(crc32(crc32(0L, Z_NULL, 0), bytes.data(), static_cast<uInt>(bytes.size())));
+  return static_cast<std::uint32_t>(crc32(crc32(0L, Z_NULL, 0), bytes, sizeof bytes));
 }
 
 void CycleEncoder::encode_key(const control::JournalRecord& r, ByteWriter& out) {
@@ -127,7 +133,7 @@ void CycleEncoder::encode(const control::JournalRecord& r, ByteWriter& out) {
       codes[i] = kSame;
     } else if (!as_steps(field(r, i), i, steps[i])) {
       codes[i] = kRaw;
-    } else if (as_steps(field(p, i), i, before)) {
+    } else if (as_steps(field(p, i), i, before) && std::fabs(static_cast<double>(steps[i] - before)) < kMostSteps) {
       codes[i] = kStepDelta;
       steps[i] -= before;
     } else {
@@ -281,12 +287,13 @@ bool CycleDecoder::decode(ByteReader& in, RecordedCycle& out, std::string& error
         field(r, i) = from_steps(in.zigzag(), i);
       } else if (code == kStepDelta) {
         if (!as_steps(field(p, i), i, before)) {
-          error = "a cycle's device field " + std::to_string(i) + " given in steps from a value that is no whole step";
+          error = std::string("a cycle's ") + kFieldName[i] + " given as steps from one before that is no whole number of " +
+                  (i < 3 ? "micrometres" : "microradians") + " (expected code 2 or 3 then)";
           return false;
         }
         const std::int64_t delta = in.zigzag();
         if (delta > static_cast<std::int64_t>(kMostSteps) || delta < -static_cast<std::int64_t>(kMostSteps)) {
-          error = "a cycle's device field " + std::to_string(i) + " moved " + std::to_string(delta) + " steps";
+          error = std::string("a cycle's ") + kFieldName[i] + " moved " + std::to_string(delta) + " steps (at most 4e15)";
           return false;
         }
         field(r, i) = from_steps(before + delta, i);
@@ -303,7 +310,8 @@ bool CycleDecoder::decode(ByteReader& in, RecordedCycle& out, std::string& error
   if ((flags & kTouched) != 0) {
     const std::uint64_t grew = in.varint();
     if (!in.overrun() && (grew == 0 || grew > std::numeric_limits<std::uint32_t>::max() - p.touched_triangles)) {
-      error = "a cycle's touched set growing by " + std::to_string(grew) + " from " + std::to_string(p.touched_triangles);
+      error = "a cycle's touched set growing by " + std::to_string(grew) + " from " + std::to_string(p.touched_triangles) +
+              " (expected more than 0, to at most 2^32 - 1)";
       return false;
     }
     r.touched_triangles = p.touched_triangles + static_cast<std::uint32_t>(grew);

@@ -59,7 +59,11 @@ struct RecordedCycle {
 class CycleEncoder {
  public:
   static constexpr std::uint32_t kKeyEvery = 1000;  // a key a second at 1 kHz
-  void restart() { have_previous_ = false; }        // a new run: its first cycle is a key
+  // A new run: its first cycle is a key, and its time steps count from 0 (as a new writer's do).
+  void restart() {
+    have_previous_ = false;
+    previous_step_ns_ = 0;
+  }
   void encode(const control::JournalRecord& record, ByteWriter& out);
 
  private:
@@ -73,13 +77,16 @@ class CycleEncoder {
 // One run's cycles, read back: each decoded against the one before.
 class CycleDecoder {
  public:
-  void restart() { have_previous_ = false; }
+  void restart() {
+    have_previous_ = false;
+    previous_step_ns_ = 0;
+  }
   // One cycle from `in`. False with `error` saying what was expected (the caller adds the offset).
   [[nodiscard]] bool decode(ByteReader& in, RecordedCycle& out, std::string& error);
   // A version 4 Cycle record read whole: the cycles after it (a version 4 journal carried on as
   // version 5) are not encoded against it (a run's first compact cycle is a key), so nothing to do
   // but remember that a key must come.
-  void whole_record_read() { have_previous_ = false; }
+  void whole_record_read() { restart(); }
 
  private:
   [[nodiscard]] bool decode_key(ByteReader& in, std::uint8_t flags, RecordedCycle& out, std::string& error);

@@ -42,6 +42,8 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
   std::size_t offset = kFileHeaderBytes;
   RecordType previous = RecordType::End;  // none yet
   CycleDecoder decoder;
+  // A run's cycles are all in one form: Cycle records (a version 2 to 4 writer's run) or Cycles.
+  enum class RunForm { None, Whole, Compact } form = RunForm::None;
   while (offset < size) {
     const std::size_t left = size - offset;
     ByteReader head(data + offset, left);
@@ -94,17 +96,21 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         start.job.assign(reinterpret_cast<const char*>(body.here()), job);
         decoder.restart();
+        form = RunForm::None;
         if (visit.start) {
           visit.start(start);
         }
         break;
       }
       case RecordType::Cycle: {
-        if (length != kCyclePayloadBytes) {
-          result.error = at(offset) + "a cycle record of " + std::to_string(length) + " bytes (expected " +
-                         std::to_string(kCyclePayloadBytes) + ")";
+        if (length != kCyclePayloadBytes || form == RunForm::Compact) {
+          result.error = at(offset) + "a cycle record of " + std::to_string(length) + " bytes" +
+                         (form == RunForm::Compact ? " in a run of compact cycles (expected a Cycles record: a run's cycles are "
+                                                     "all in one form)"
+                                                   : " (expected " + std::to_string(kCyclePayloadBytes) + ")");
           return result;
         }
+        form = RunForm::Whole;
         control::JournalRecord r{};
         r.cycle = body.u64();
         r.time_ns = body.i64();
@@ -152,11 +158,15 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         break;
       }
       case RecordType::Cycles: {
-        if (version < kCompactVersion) {
-          result.error = at(offset) + "a cycles record in a version " + std::to_string(version) +
-                         " journal (version 5 has them)";
+        if (version < kCompactVersion || form == RunForm::Whole || length == 0) {
+          result.error = at(offset) + (version < kCompactVersion
+                                           ? "a cycles record in a version " + std::to_string(version) + " journal (version 5 has them)"
+                                       : length == 0 ? std::string("an empty cycles record (expected at least one cycle)")
+                                                     : std::string("a cycles record in a run of cycle records (expected a Cycle "
+                                                                   "record: a run's cycles are all in one form)"));
           return result;
         }
+        form = RunForm::Compact;
         RecordedCycle recorded;
         std::string why;
         while (body.left() > 0) {
@@ -304,6 +314,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         resume.program.assign(reinterpret_cast<const char*>(body.here()), name);
         decoder.restart();
+        form = RunForm::None;
         if (visit.resume) {
           visit.resume(resume);
         }
