@@ -57,6 +57,9 @@ debian_root_mount "$root"
 
 step "install $(basename "$deb") with apt ($(du -h "$deb" | cut -f1) on disk)"
 cp "$deb" "$root/tmp/"
+# mmdebstrap leaves the root without package lists; the package's libraries beyond the important set
+# (libpng16-16, for the simulation's picture) come from the archive, as on a machinist's machine.
+in_root apt-get update -qq >"$work/update.log" 2>&1 || { cat "$work/update.log"; fail "apt-get update in the root"; }
 in_root dpkg-query -W -f '${Package}\n' | sort >"$work/before.txt"
 in_root apt-get install -y --no-install-recommends "/tmp/$(basename "$deb")" >"$work/install.log" 2>&1 ||
   { cat "$work/install.log"; fail "apt could not install the package"; }
