@@ -73,21 +73,8 @@ void add_record_options(CLI::App& app, RigOptions& o) {
                  "record the job here: every cycle's sample, virtual tool and force, every machine command (written "
                  "before it is sent), every safe-state event; used as given (default: job.journal in the job's folder)");
   app.add_flag("--no-journal", o.no_journal, "record no journal (the job cannot be resumed)");
-  app.add_option("--out-dir", o.out_dir,
-                 "DIR: the jobs folder (made with its parents if missing). Each job writes in a folder of its own "
-                 "there, stencil-rig-YYYYMMDD-HHMMSS (its local start time; -2, -3 ... when taken): job.journal and "
-                 "report.json; DIR/latest links to the newest. Checked before anything moves. A --resume writes in "
-                 "its journal's folder (default: the --config file's job.output_folder, else "
-                 "$XDG_STATE_HOME/stencil/jobs, else ~/.local/state/stencil/jobs)");
-  app.add_option("--keep-jobs", o.keep_jobs,
-                 "N: as a new job starts, the oldest job folders in the jobs folder beyond the newest N (this one "
-                 "counted) are removed, each said; never one whose journal's last run has no End (killed: it may "
-                 "be resumed). 0: keep every job (default: the file's job.keep_jobs, else 50)")
-      ->check(CLI::Range(0U, 100000U));
-  app.add_option("--keep-mb", o.keep_mb,
-                 "M: as --keep-jobs, the newest job folders that fit in M MB kept, older ones removed (default: the "
-                 "file's job.keep_mb, else 0: no size cap)")
-      ->check(CLI::Range(0U, 100000000U));
+  add_job_folder_options(app, o.jobs, "stencil-rig", "job.journal and report.json, checked before anything moves",
+                         "A --resume writes in its journal's folder");
   app.add_option("--resume", o.resume_path,
                  "carry on the job this journal recorded (after a crash, a kill or a safe state), with the same --tables, "
                  "--work-offset, stick-outs and --stock: the touched set and the model of the machined stock are rebuilt "
@@ -168,7 +155,7 @@ bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& 
     error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
     return false;
   }
-  if (!o.resume_path.empty() && !o.out_dir.empty()) {
+  if (!o.resume_path.empty() && !o.jobs.out_dir.empty()) {
     error = "--out-dir: a --resume writes in its journal's folder";
     return false;
   }
@@ -185,8 +172,7 @@ bool apply_rig_config(const CLI::App& app, RigOptions& o, std::string& error) {
   if (app.count("--haptic") == 0) o.haptic = c.haptic_link;
   if (app.count("--priority") == 0 && file) o.priority = c.cycle_priority;
   if (app.count("--cpu") == 0 && file) o.cpu = c.cycle_cpu;
-  if (app.count("--keep-jobs") == 0) o.keep_jobs = c.keep_jobs;
-  if (app.count("--keep-mb") == 0) o.keep_mb = c.keep_mb;
+  take_configured_retention(app, o.jobs, c.keep_jobs, c.keep_mb);
   if (app.count("--work-offset") == 0 && file) {
     char text[96];
     std::snprintf(text, sizeof text, "%.17g,%.17g,%.17g", c.work_offset_mm[0], c.work_offset_mm[1], c.work_offset_mm[2]);

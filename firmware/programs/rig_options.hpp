@@ -10,6 +10,7 @@
 #include "board/sherline_suzuki/rig_job.hpp"
 #include "firmware/core/control/commanded_stock.hpp"
 #include "firmware/programs/display_option.hpp"
+#include "firmware/programs/job_folder_option.hpp"
 #include "firmware/services/report/provenance.hpp"
 
 namespace stencil::app {
@@ -33,9 +34,7 @@ struct RigOptions {
   std::string stock_text;     // empty: the whole workspace
   std::string report_path;    // empty: report.json in the job's folder (a --resume's report-resume-N.json)
   std::string journal_path;   // empty: job.journal in the job's folder
-  std::string out_dir;        // --out-dir: the jobs folder (empty: the file's job.output_folder, else the XDG default)
-  unsigned keep_jobs = 50;    // --keep-jobs, else the file's job.keep_jobs
-  unsigned keep_mb = 0;       // --keep-mb, else the file's job.keep_mb
+  JobFolderOptions jobs;      // --out-dir, --keep-jobs, --keep-mb
   bool no_journal = false;
   std::string resume_path;
   double duration_s = 0.0;

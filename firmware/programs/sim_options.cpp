@@ -47,24 +47,11 @@ void add_record_options(CLI::App& app, SimOptions& o) {
                  "record the job here: every cycle's device sample, virtual tool and force, every machine command "
                  "(written before it is sent) and every safe-state event, with a CRC-32 each, synced to the disk every "
                  "second and at once on a safe state; used as given (default: job.journal in the job's folder; about "
-                 "400 MB per simulated hour)");
-  app.add_option("--out-dir", o.out_dir,
-                 "DIR: the jobs folder (made with its parents if missing). Each job writes in a folder of its own "
-                 "there, stencil-sim-YYYYMMDD-HHMMSS (its local start time; -2, -3 ... when taken): job.journal, "
-                 "report.json and its picture, and any --trace, --stock-csv, --script-csv or --device-process file "
-                 "given as a bare name (a path with a slash is used as given); DIR/latest links to the newest. A "
-                 "--resume and a --replay write in their journal's folder instead (default: the --config file's "
-                 "job.output_folder, else $XDG_STATE_HOME/stencil/jobs, else ~/.local/state/stencil/jobs)");
-  app.add_option("--keep-jobs", o.keep_jobs,
-                 "N: as a new job starts, the oldest job folders in the jobs folder beyond the newest N (this one "
-                 "counted) are removed, each said; never one whose journal's last run has no End (killed or "
-                 "still running: it may be resumed). 0: keep every job (default: the --config file's "
-                 "job.keep_jobs, else 50)")
-      ->check(CLI::Range(0U, 100000U));
-  app.add_option("--keep-mb", o.keep_mb,
-                 "M: as --keep-jobs, the newest job folders that fit in M MB kept, older ones removed (default: the "
-                 "--config file's job.keep_mb, else 0: no size cap)")
-      ->check(CLI::Range(0U, 100000000U));
+                 "40 MB per simulated hour)");
+  add_job_folder_options(app, o.jobs, "stencil-sim",
+                         "job.journal, report.json and its picture, and any --trace, --stock-csv, --script-csv or "
+                         "--device-process file given as a bare name (a path with a slash is used as given)",
+                         "A --resume and a --replay write in their journal's folder instead");
   app.add_flag("--no-journal", o.no_journal, "record no journal (the job cannot be resumed)");
   app.add_option("--resume", o.resume_path,
                  "carry on the job this journal recorded (after a crash, a kill or a safe state), given the same "
@@ -168,7 +155,7 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     o.fast = o.fast || o.speed == 0.0;
     o.no_journal = true;
   }
-  if (!o.out_dir.empty() && (!o.resume_path.empty() || !o.replay_path.empty())) {
+  if (!o.jobs.out_dir.empty() && (!o.resume_path.empty() || !o.replay_path.empty())) {
     error = "--out-dir: a --resume or a --replay writes in its journal's folder";
   } else if (!o.resume_path.empty() && (!o.journal_path.empty() || o.no_journal)) {
     error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
@@ -194,8 +181,7 @@ bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
     o.commissioning = config.commissioning;
     o.config_crc32 = config.file_crc32;
     o.output_folder = config.output_folder;
-    if (app.count("--keep-jobs") == 0) o.keep_jobs = config.keep_jobs;
-    if (app.count("--keep-mb") == 0) o.keep_mb = config.keep_mb;
+    take_configured_retention(app, o.jobs, config.keep_jobs, config.keep_mb);
     if (app.count("--priority") == 0) o.priority = config.cycle_priority;
     if (app.count("--cpu") == 0) o.cpu = config.cycle_cpu;
   }

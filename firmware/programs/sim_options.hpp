@@ -11,6 +11,7 @@
 #include "board/sim/fault_injection.hpp"
 #include "board/sim/sim_facts.hpp"
 #include "firmware/programs/display_option.hpp"
+#include "firmware/programs/job_folder_option.hpp"
 
 namespace stencil::app {
 
@@ -22,9 +23,7 @@ struct SimOptions {
   board::sherline_suzuki::CommissioningSettings commissioning;  // the file's [commissioning]
   std::uint32_t config_crc32 = 0, mill_truth_crc32 = 0;          // the files', for the journal's job (0: none)
   std::string output_folder;                                     // the file's job.output_folder
-  std::string out_dir;        // --out-dir: the jobs folder this job's own folder is made in (empty: the default)
-  unsigned keep_jobs = 50;    // --keep-jobs, else the file's job.keep_jobs (0: every job kept)
-  unsigned keep_mb = 0;       // --keep-mb, else the file's job.keep_mb (0: no size cap)
+  JobFolderOptions jobs;      // --out-dir, --keep-jobs, --keep-mb
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
   std::string pattern_name = "raster";

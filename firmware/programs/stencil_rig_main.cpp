@@ -75,16 +75,9 @@ bool place_outputs(app::RigOptions& o, std::uint32_t resume_segment, report::Job
   if (!o.resume_path.empty()) {
     folder.use_folder_of(o.resume_path);
     report_name = "report-resume-" + std::to_string(resume_segment) + ".json";
-  } else if (!o.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal)) {
-    const report::JobFolderRequest request{
-        "stencil-rig",
-        o.out_dir.empty()
-            ? report::default_jobs_folder(o.config.output_folder, std::getenv("XDG_STATE_HOME"), std::getenv("HOME"))
-            : o.out_dir,
-        {o.keep_jobs, std::uint64_t{o.keep_mb} * 1'000'000U}};
-    if (!folder.make(request, std::time(nullptr),
-                     [](const std::string& line) { std::printf("stencil-rig: %s\n", line.c_str()); }, error)) {
-      error = (o.out_dir.empty() ? "" : "--out-dir: ") + error;
+  } else if (!o.jobs.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal)) {
+    if (!app::make_job_folder(o.jobs, "stencil-rig", o.config.output_folder, folder,
+                              [](const std::string& line) { std::printf("stencil-rig: %s\n", line.c_str()); }, error)) {
       return false;
     }
     std::printf("stencil-rig: job folder %s\n", folder.path().c_str());

@@ -337,15 +337,9 @@ bool place_outputs(app::SimOptions& o, std::uint32_t resume_segment, report::Job
   if (!o.replay_path.empty() || !o.resume_path.empty()) {
     folder.use_folder_of(o.replay_path.empty() ? o.resume_path : o.replay_path);
     report_name = o.replay_path.empty() ? "report-resume-" + std::to_string(resume_segment) + ".json" : "replay.json";
-  } else if (!o.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal) || bare_side_output) {
-    const report::JobFolderRequest request{
-        "stencil-sim",
-        o.out_dir.empty() ? report::default_jobs_folder(o.output_folder, std::getenv("XDG_STATE_HOME"), std::getenv("HOME"))
-                          : o.out_dir,
-        {o.keep_jobs, std::uint64_t{o.keep_mb} * 1'000'000U}};
-    if (!folder.make(request, std::time(nullptr), [](const std::string& line) { std::printf("%s\n", line.c_str()); },
-                     error)) {
-      error = (o.out_dir.empty() ? "" : "--out-dir: ") + error;
+  } else if (!o.jobs.out_dir.empty() || o.report_path.empty() || (o.journal_path.empty() && !o.no_journal) || bare_side_output) {
+    if (!app::make_job_folder(o.jobs, "stencil-sim", o.output_folder, folder,
+                              [](const std::string& line) { std::printf("%s\n", line.c_str()); }, error)) {
       return false;
     }
     std::printf("job folder: %s\n", folder.path().c_str());

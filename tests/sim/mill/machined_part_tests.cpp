@@ -89,18 +89,22 @@ struct PrismJob {
   }
 };
 
+// From the origin (far from the prism) along y, up to z = 5.75, then along x across the prism's
+// middle: the tip is 0.25 mm into its top face (z = 6) there, a gouge of 0.25 mm.
+static void gouge_the_prisms_top(MachinedPart& machined) {
+  const auto at = &PrismJob::at;
+  machined.axis_moved(Axis::y, at(0.0, 12.5, 0.0));
+  machined.axis_moved(Axis::z, at(0.0, 12.5, 5.75));
+  machined.axis_moved(Axis::x, at(25.0, 12.5, 5.75));
+  machined.flush();
+}
+
 TEST_GROUP(MachinedPart){};
 
 TEST(MachinedPart, ALegThatCutsIntoThePrismIsAGougeOfItsDepth) {
   PrismJob job;
   MachinedPart& machined = *job.machined;
-  const auto at = &PrismJob::at;
-  // From the origin (far from the prism) along y, up to z = 5.75, then along x across the prism's
-  // middle: the tip is 0.25 mm into its top face (z = 6) there, a gouge of 0.25 mm.
-  machined.axis_moved(Axis::y, at(0.0, 12.5, 0.0));
-  machined.axis_moved(Axis::z, at(0.0, 12.5, 5.75));
-  machined.axis_moved(Axis::x, at(25.0, 12.5, 5.75));
-  machined.flush();
+  gouge_the_prisms_top(machined);
   DOUBLES_EQUAL(0.25, machined.max_gouge_mm(), 0.002);
   CHECK(machined.gouge_measured());
 }
@@ -120,12 +124,7 @@ TEST(MachinedPart, ALegClearOfThePartIsNoGouge) {
 TEST(MachinedPart, EachCellsSignedDistanceIsFromItsTopToThePrismsSurface) {
   PrismJob job;
   MachinedPart& machined = *job.machined;
-  const auto at = &PrismJob::at;
-  // The leg that gouges the prism's top by 0.25 mm (above), from x = 0 to its middle.
-  machined.axis_moved(Axis::y, at(0.0, 12.5, 0.0));
-  machined.axis_moved(Axis::z, at(0.0, 12.5, 5.75));
-  machined.axis_moved(Axis::x, at(25.0, 12.5, 5.75));
-  machined.flush();
+  gouge_the_prisms_top(machined);
   const StockZmap& stock = machined.stock();
   const std::vector<float> distance = machined.signed_distances(machined.part_heights(), 2.0);
   LONGS_EQUAL(static_cast<long>(stock.columns()) * stock.rows(), static_cast<long>(distance.size()));
