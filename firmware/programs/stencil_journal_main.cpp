@@ -108,7 +108,9 @@ int read(const std::string& path, bool cycles_json) {
     std::FILE* file = std::fopen(path.c_str(), "rb");
     unsigned char header[12] = {};
     if (file != nullptr && std::fread(header, 1, sizeof header, file) == sizeof header) {
-      c.version = header[8] | header[9] << 8U | header[10] << 16U | static_cast<std::uint32_t>(header[11]) << 24U;
+      for (int i = 3; i >= 0; --i) {
+        c.version = c.version << 8U | header[8 + i];  // little-endian
+      }
     }
     if (file != nullptr) {
       std::fclose(file);
