@@ -1,6 +1,8 @@
-// The PIO shared memory backend: the window's header check, seqlock reads that never accept a torn
-// sample, stale and frozen devices, range rules on both sides, arming the device's host watchdog (a
-// restarted host, a trip during the run), and the time of one cycle.
+// The PIO shared memory backend's own behaviour, beyond the HapticDevice contract that
+// tests/hal/haptic_device_contract_tests.cpp runs on every backend (fresh, stale, lost, range,
+// clamping, torn samples): a writer stuck mid-write, the device's own limits, the host heartbeat
+// carried across a host restart, arming the device's host watchdog (a restarted host, a trip during
+// the run), seqlock reads racing a real writer thread, and the time of one cycle.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -10,7 +12,6 @@
 #include <vector>
 
 #include "board/sherline_suzuki/rig_facts.hpp"
-#include "hal/haptic_range_checks.hpp"
 #include "hal/pio_shared_memory/pio_device_side.hpp"
 #include "hal/pio_shared_memory/pio_haptic_device.hpp"
 #include "hal/pio_shared_memory/seqlock.hpp"
@@ -21,6 +22,7 @@
 #include "tests/hal/pio_shared_memory/haptic_result_strings.hpp"
 #include "tests/hal/pio_shared_memory/window_pair.hpp"
 #include "tests/sim/haptic_device/counter_pose.hpp"
+#include "tests/support/haptic_test_values.hpp"
 
 #include <CppUTest/TestHarness.h>
 
@@ -30,62 +32,15 @@ using test::consistent_with_counter;
 using test::counter_pose;
 using hal::ReadStatus;
 using hal::WriteStatus;
+using test::command_of;
+using test::marker_sample;
 namespace pio = hal::pio_shared_memory;
 
 namespace {
 
 constexpr hal::MonotonicNs kMs = 1'000'000;
 
-hal::HapticSample marker_sample() {
-  hal::HapticSample sample{};
-  sample.position_mm[0] = 12345.0;
-  sample.sample_counter = 0xDEADU;
-  return sample;
-}
-
-hal::HapticCommand command_of(double fx, double fy, double fz, bool enable = true) {
-  return hal::HapticCommand{{fx, fy, fz}, {0.0, 0.0}, 7, enable};
-}
-
 }  // namespace
-
-TEST_GROUP(PioSharedWindow) {
-  test::WindowPair windows = test::make_device_window();
-};
-
-TEST(PioSharedWindow, HostRefusesAWindowTheDeviceHasNotInitialised) {
-  CHECK_TRUE(windows.device != nullptr);
-  test::open_host_window(windows);
-  CHECK_TRUE(windows.host == nullptr);
-  STRCMP_CONTAINS("byte 0 (magic): 0x00000000, expected 0x50415448", windows.error.c_str());
-
-  sim::PioDeviceLink device_link(windows.device->window());
-  test::open_host_window(windows);
-  CHECK_TRUE(windows.host != nullptr);
-  CHECK_EQUAL(pio::kWindowMagic, windows.host->window().header.magic);
-}
-
-TEST(PioSharedWindow, HostRefusesAWindowOfAnotherLayoutVersion) {
-  sim::PioDeviceLink device_link(windows.device->window());
-  windows.device->window().header.layout_version = pio::kLayoutVersion + 1;
-  test::open_host_window(windows);
-  CHECK_TRUE(windows.host == nullptr);
-  STRCMP_CONTAINS("byte 4 (layout version): 2, expected 1", windows.error.c_str());
-}
-
-TEST(PioSharedWindow, OpeningAFileShorterThanTheWindowNamesBothSizes) {
-  std::string error;
-  CHECK_TRUE(pio::SharedWindowMapping::open("/dev/null", 0, false, error) == nullptr);
-  CHECK_TRUE(!error.empty());
-  char path[] = "/tmp/haptic-short-window-XXXXXX";
-  const int fd = ::mkstemp(path);
-  CHECK_TRUE(fd >= 0);
-  CHECK_EQUAL(0, ::ftruncate(fd, 100));
-  ::close(fd);
-  CHECK_TRUE(pio::SharedWindowMapping::open(path, 0, false, error) == nullptr);
-  ::unlink(path);
-  STRCMP_CONTAINS("100 bytes, expected at least 192", error.c_str());
-}
 
 TEST_GROUP(PioHapticDevice) {
   test::WindowPair windows;
@@ -125,38 +80,8 @@ TEST_GROUP(PioHapticDevice) {
   }
 };
 
-TEST(PioHapticDevice, GivesEachNewSampleOnceInMillimetresAndRadians) {
-  hal::HapticSample sample = marker_sample();
-  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(0, sample).status);  // the device has not written yet
-  CHECK_EQUAL(hal::HapticLinkState::WaitingForDevice, host->link_state());
-  DOUBLES_EQUAL(12345.0, sample.position_mm[0], 0.0);
-
-  device->step(1 * kMs);
-  const hal::ReadResult first = host->read_sample(1 * kMs, sample);
-  CHECK_EQUAL(ReadStatus::Fresh, first.status);
-  CHECK_EQUAL(HapticFault::None, first.reason);
-  CHECK_EQUAL(1U, sample.sample_counter);
-  DOUBLES_EQUAL(-99.9, sample.position_mm[0], 1e-9);
-  DOUBLES_EQUAL(-0.05, sample.position_mm[1], 1e-9);
-  DOUBLES_EQUAL(0.025, sample.position_mm[2], 1e-9);
-  DOUBLES_EQUAL(-0.999, sample.angles_rad[0], 1e-9);
-  DOUBLES_EQUAL(0.9995, sample.angles_rad[1], 1e-9);
-  CHECK_EQUAL(1U, sample.device_heartbeat);
-  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
-
-  sample = marker_sample();
-  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(1 * kMs, sample).status);
-  CHECK_EQUAL(0xDEADU, sample.sample_counter);  // untouched
-  device->step(2 * kMs);
-  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(2 * kMs, sample).status);
-  CHECK_EQUAL(2U, sample.sample_counter);
-
-  const hal::HapticCounters counters = host->counters();
-  CHECK_EQUAL(2U, counters.samples_accepted);
-  CHECK_EQUAL(2U, counters.stale_reads);
-}
-
-TEST(PioHapticDevice, ReportsBusyAndKeepsTheOldSampleWhenTheDeviceIsStuckMidWrite) {
+// The contract's torn sample, carried on: a writer that never finishes also stops its heartbeat.
+TEST(PioHapticDevice, AWriterStuckMidWriteIsBusyThenLostPastTheWatchdogTime) {
   device->step(1 * kMs);
   hal::HapticSample sample{};
   CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);
@@ -187,107 +112,6 @@ TEST(PioHapticDevice, ReportsBusyAndKeepsTheOldSampleWhenTheDeviceIsStuckMidWrit
   CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(60 * kMs, after).status);
   CHECK_EQUAL(2U, after.sample_counter);
   CHECK_TRUE(consistent_with_counter(after));
-}
-
-TEST(PioHapticDevice, AFrozenDeviceReadsStaleThenDisconnectsAfterTheWatchdogTime) {
-  hal::HapticSample sample{};
-  for (int ms = 1; ms <= 10; ++ms) {
-    device->step(ms * kMs);
-    CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(ms * kMs, sample).status);
-  }
-  device->set_frozen(true);
-  const hal::MonotonicNs frozen_at = 10 * kMs;
-  for (hal::MonotonicNs now = frozen_at + kMs; now <= frozen_at + pio::kDefaultDeviceWatchdogNs; now += kMs) {
-    device->step(now);
-    hal::HapticSample stale = marker_sample();
-    const hal::ReadResult result = host->read_sample(now, stale);
-    CHECK_EQUAL(ReadStatus::Stale, result.status);
-    CHECK_EQUAL(0xDEADU, stale.sample_counter);
-  }
-  CHECK_EQUAL(10U, sample.device_heartbeat);  // the last heartbeat the caller saw, frozen since
-  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
-
-  const hal::MonotonicNs late = frozen_at + pio::kDefaultDeviceWatchdogNs + kMs;
-  const hal::ReadResult lost = host->read_sample(late, sample);
-  CHECK_EQUAL(ReadStatus::Fault, lost.status);
-  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, lost.reason);
-  CHECK_EQUAL(hal::HapticLinkState::Disconnected, host->link_state());
-  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());
-
-  // Back again: fresh samples, connected, but the latch holds until the caller clears it.
-  device->set_frozen(false);
-  device->step(late + kMs);
-  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(late + kMs, sample).status);
-  CHECK_EQUAL(11U, sample.sample_counter);
-  CHECK_EQUAL(hal::HapticLinkState::Connected, host->link_state());
-  CHECK_EQUAL(HapticFault::DeviceHeartbeatLost, host->latched_fault());
-  host->clear_fault();
-  CHECK_EQUAL(HapticFault::None, host->latched_fault());
-}
-
-TEST(PioHapticDevice, RefusesAPoseBeyondTheDevicesReach) {
-  sim::SimulatedHapticDevice far_device(*device_link, [](std::uint32_t k, hal::MonotonicNs) {
-    return k == 2 ? sim::SimulatedPose{{0.0, 150.001, 0.0}, {0.0, 0.0}} : sim::SimulatedPose{{275.0, -150.0, 150.0}, {3.2, -3.2}};
-  });
-  hal::HapticSample sample{};
-  far_device.step(1 * kMs);
-  CHECK_EQUAL(ReadStatus::Fresh, host->read_sample(1 * kMs, sample).status);  // exactly at the limits
-  DOUBLES_EQUAL(275.0, sample.position_mm[0], 1e-9);
-
-  far_device.step(2 * kMs);
-  const hal::ReadResult refused = host->read_sample(2 * kMs, sample);
-  CHECK_EQUAL(ReadStatus::Rejected, refused.status);
-  CHECK_EQUAL(HapticFault::SampleOutOfRange, refused.reason);
-  CHECK_EQUAL(1U, sample.sample_counter);
-  CHECK_EQUAL(1U, host->counters().samples_out_of_range);
-  CHECK_EQUAL(ReadStatus::Stale, host->read_sample(2 * kMs, sample).status);  // refused once, then nothing new
-}
-
-TEST(PioHapticDevice, ClampsForceAndTorqueToTheirLimitsBeforeWriting) {
-  arm_the_device(1, 5);
-  hal::HapticCommand command = command_of(6.0, 8.0, 0.0);  // 10 N
-  command.torque_nmm[0] = 300.0;
-  command.torque_nmm[1] = -400.0;  // 500 N.mm
-  const hal::WriteResult result = host->write_command(command);
-  CHECK_EQUAL(WriteStatus::Clamped, result.status);
-  const pio::CommandBlock& block = windows.device->window().command;
-  CHECK_EQUAL(3000, block.force_mn[0]);
-  CHECK_EQUAL(4000, block.force_mn[1]);
-  CHECK_EQUAL(0, block.force_mn[2]);
-  CHECK_EQUAL(120000, block.torque_mnmm[0]);
-  CHECK_EQUAL(-160000, block.torque_mnmm[1]);
-  CHECK_EQUAL(pio::kCommandEnableBit, block.flags);
-  CHECK_EQUAL(7U, block.cycle_counter);
-  CHECK_EQUAL(1U, host->counters().commands_clamped);
-
-  // A diagonal at the limit rounds toward zero, so the device never sees more than 5000 mN.
-  CHECK_EQUAL(WriteStatus::Clamped, host->write_command(command_of(100.0, 100.0, 100.0)).status);
-  pio::CommandWords words{};
-  pio::load_fields(windows.device->window().command, words);
-  CHECK_TRUE(pio::command_within_device_limits(words));
-
-  device->step(6 * kMs);
-  const sim::DeviceOutput output = device->output();
-  CHECK_TRUE(output.force_applied);
-  DOUBLES_EQUAL(5.0 / std::sqrt(3.0), output.force_n[0], 1e-3);
-}
-
-TEST(PioHapticDevice, SendsZeroForceWithEnableOffForANonFiniteCommand) {
-  arm_the_device(1, 5);
-  CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(1.0, 0.0, 0.0)).status);
-  const std::uint32_t heartbeat_before = windows.device->window().command.host_heartbeat;
-  hal::HapticCommand command = command_of(1.0, std::nan(""), 0.0);
-  const hal::WriteResult result = host->write_command(command);
-  CHECK_EQUAL(WriteStatus::Rejected, result.status);
-  CHECK_EQUAL(HapticFault::CommandNotFinite, result.reason);
-  const pio::CommandBlock& block = windows.device->window().command;
-  CHECK_EQUAL(0, block.force_mn[0]);
-  CHECK_EQUAL(0U, block.flags);
-  CHECK_EQUAL(heartbeat_before + 1, block.host_heartbeat);  // still beating
-  command.force_n[1] = 0.0;
-  command.torque_nmm[0] = INFINITY;
-  CHECK_EQUAL(WriteStatus::Rejected, host->write_command(command).status);
-  CHECK_EQUAL(2U, host->counters().commands_rejected);
 }
 
 TEST(PioHapticDevice, TheDeviceRefusesACommandBeyondItsOwnLimits) {
@@ -326,11 +150,13 @@ TEST(PioHapticDevice, TheDeviceRefusesACommandBeyondItsOwnLimits) {
   DOUBLES_EQUAL(2.5, output.force_n[2], 1e-9);
 }
 
-TEST(PioHapticDevice, TheHostHeartbeatMovesWithEveryWriteAndContinuesAfterARestart) {
+// The window outlives the host program: a new one continues the heartbeat it finds there, so the
+// device never sees it stand still (or go back) across a restart.
+TEST(PioHapticDevice, ARestartedHostContinuesTheHostHeartbeatItFindsInTheWindow) {
   for (int write = 1; write <= 3; ++write) {
     CHECK_EQUAL(WriteStatus::Written, host->write_command(command_of(0.0, 0.0, 0.0, false)).status);
-    CHECK_EQUAL(static_cast<std::uint32_t>(write), windows.device->window().command.host_heartbeat);
   }
+  CHECK_EQUAL(3U, windows.device->window().command.host_heartbeat);
   pio::PioHapticDevice restarted(&windows.host->window(), stencil::board::sherline_suzuki::kCentredDeviceRange);
   CHECK_EQUAL(WriteStatus::Written, restarted.write_command(command_of(0.0, 0.0, 0.0, false)).status);
   CHECK_EQUAL(4U, windows.device->window().command.host_heartbeat);
@@ -582,25 +408,4 @@ TEST(PioHapticDevice, MeasuresTheReadAndWriteOfOneCycle) {
               durations_ns[kCycles / 2], kCycles);
   CHECK_EQUAL(kCycles, fresh);
   CHECK_EQUAL(kCycles, written);
-}
-
-TEST_GROUP(HapticRangeRules){};
-
-TEST(HapticRangeRules, WithTheOriginAtACornerTheWholeReachIsAcceptedAndNothingPastItsMargin) {
-  hal::HapticSample sample{};
-  const auto at = [&](double x, double y, double z) {
-    sample.position_mm[0] = x;
-    sample.position_mm[1] = y;
-    sample.position_mm[2] = z;
-    return hal::sample_in_range(sample, stencil::board::sherline_suzuki::kDeviceRange);
-  };
-  CHECK_TRUE(at(0.0, 0.0, 0.0));
-  CHECK_TRUE(at(500.0, 250.0, 250.0));
-  CHECK_TRUE(at(-25.0, 275.0, 125.0));
-  CHECK_FALSE(at(525.001, 0.0, 0.0));
-  CHECK_FALSE(at(0.0, -25.001, 0.0));
-  CHECK_FALSE(at(0.0, 0.0, NAN));
-  CHECK_FALSE(hal::sample_in_range(sample, stencil::board::sherline_suzuki::kCentredDeviceRange));  // the centred reach says no to z NaN too
-  CHECK_TRUE(at(250.0, 125.0, 125.0));
-  CHECK_FALSE(hal::sample_in_range(sample, hal::HapticRange{{1.0, 1.0, 1.0}, 3.2, 5.0, 200.0, {0.0, 0.0, 0.0}}));
 }
