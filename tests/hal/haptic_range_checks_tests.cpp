@@ -39,10 +39,11 @@ double norm3(const double (&v)[3]) { return std::sqrt(v[0] * v[0] + v[1] * v[1] 
 TEST_GROUP(HapticRangeChecks){};
 
 TEST(HapticRangeChecks, ASampleIsFiniteOnlyWhenEveryPositionAndAngleIs) {
+  CHECK_TRUE(hal::sample_in_range(sample_at(10.0, 20.0, 30.0), kSmallRange));
   CHECK_TRUE(hal::sample_finite(sample_at(1e300, -1e300, 0.0, 1e9, -1e9)));  // huge is still finite
   for (int field = 0; field < 5; ++field) {
     for (const double bad : {kNaN, kInfinity, -kInfinity}) {
-      hal::HapticSample sample = sample_at(0.0, 0.0, 0.0);
+      hal::HapticSample sample = sample_at(10.0, 20.0, 30.0);  // the centre: only the bad field can refuse it
       if (field < 3) {
         sample.position_mm[field] = bad;
       } else {

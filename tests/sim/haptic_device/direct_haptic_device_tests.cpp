@@ -40,8 +40,8 @@ TEST(DirectHapticDevice, APoseIsRoundedToWholeMicrometresAndMicroradiansAsTheWin
   DOUBLES_EQUAL(-0.123457, out.angles_rad[1], 1e-12);
 }
 
-TEST(DirectHapticDevice, AValueNoWireCouldCarryIsKeptForTheRangeCheckToRefuse) {
-  // 3e6 mm is 3e9 um, past 2^31: rounding it would wrap on a wire, so it is passed on as it is.
+TEST(DirectHapticDevice, AValueNoWireCouldCarryIsRefusedAsOutOfRange) {
+  // 3e6 mm is 3e9 um, past 2^31: a wire would saturate it; here it is passed on unrounded, and refused.
   device.publish(sample_at(3e6, 0.0, 0.0));
   const hal::ReadResult far = device.read_sample(0, out);
   CHECK_EQUAL(ReadStatus::Rejected, far.status);
