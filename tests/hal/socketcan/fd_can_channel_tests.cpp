@@ -92,12 +92,16 @@ TEST(FdCanChannel, AFullQueueIsWouldBlockAndTheFrameIsNotSent) {
 }
 
 TEST(FdCanChannel, APeerThatClosedIsClosedOnBothCalls) {
-  CHECK_EQUAL(TransferStatus::Done, sockets.host.send(frame_with(can::kForceId, 1)));
-  ::close(sockets.host.fd());  // the device channel's peer is gone (the host channel closes -1 later: harmless)
+  int fds[2];
+  CHECK_EQUAL(0, ::socketpair(AF_UNIX, SOCK_SEQPACKET | SOCK_CLOEXEC, 0, fds));
+  can::FdCanChannel device(fds[1]);
+  const can_frame sent = frame_with(can::kForceId, 1);
+  CHECK_EQUAL(static_cast<ssize_t>(sizeof sent), ::send(fds[0], &sent, sizeof sent, 0));
+  ::close(fds[0]);  // the peer is gone
   can_frame received{};
-  CHECK_EQUAL(TransferStatus::Done, sockets.device.receive(received));  // what was sent still arrives
-  CHECK_EQUAL(TransferStatus::Closed, sockets.device.receive(received));
-  CHECK_EQUAL(TransferStatus::Closed, sockets.device.send(frame_with(can::kPoseAId, 1)));  // no SIGPIPE either
+  CHECK_EQUAL(TransferStatus::Done, device.receive(received));  // what was sent before still arrives
+  CHECK_EQUAL(TransferStatus::Closed, device.receive(received));
+  CHECK_EQUAL(TransferStatus::Closed, device.send(frame_with(can::kPoseAId, 1)));  // and no SIGPIPE
 }
 
 TEST(FdCanChannel, AnInvalidDescriptorIsAnErrorNotAHang) {
