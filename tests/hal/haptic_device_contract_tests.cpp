@@ -66,6 +66,9 @@ class BackendUnderTest {
   [[nodiscard]] virtual std::optional<hal::MonotonicNs> device_watchdog_ns() const = 0;
   // Whether the device side sees a host heartbeat (sim::DeviceCommand::host_heartbeat).
   [[nodiscard]] virtual bool carries_host_heartbeat() const = 0;
+  // The host program starts again on the same device side with another board's range (the device
+  // side, and what it last received, stay).
+  virtual void restart_host(const hal::HapticRange& range) = 0;
   // Whether a NaN or infinity the device side gives reaches the backend as one (no wire carries one:
   // the device's link saturates it, so a wire backend sees a number, perhaps out of range).
   [[nodiscard]] virtual bool carries_non_finite() const = 0;
@@ -74,12 +77,12 @@ class BackendUnderTest {
 // In process: the device side publishes into the backend itself, the command is read back from it.
 class DirectBackend final : public BackendUnderTest {
  public:
-  hal::HapticDevice& host() override { return device_; }
-  void publish(const hal::HapticSample& sample) override { device_.publish(sample); }
+  hal::HapticDevice& host() override { return *device_; }
+  void publish(const hal::HapticSample& sample) override { device_->publish(sample); }
   // A publish is one call on the cycle's own thread: there is nothing half-written to read.
   std::optional<HapticFault> tear(const hal::HapticSample&) override { return std::nullopt; }
   sim::DeviceCommand device_command() override {
-    const hal::HapticCommand& rendered = device_.rendered();
+    const hal::HapticCommand& rendered = device_->rendered();
     return {{rendered.force_n[0], rendered.force_n[1], rendered.force_n[2]},
             {rendered.torque_nmm[0], rendered.torque_nmm[1]},
             rendered.cycle_counter,
@@ -89,9 +92,11 @@ class DirectBackend final : public BackendUnderTest {
   [[nodiscard]] std::optional<hal::MonotonicNs> device_watchdog_ns() const override { return std::nullopt; }
   [[nodiscard]] bool carries_host_heartbeat() const override { return false; }
   [[nodiscard]] bool carries_non_finite() const override { return true; }
+  // In process the device is the backend: a new one, rendering nothing until written.
+  void restart_host(const hal::HapticRange& range) override { device_ = std::make_unique<sim::DirectHapticDevice>(range); }
 
  private:
-  sim::DirectHapticDevice device_{kRange};
+  std::unique_ptr<sim::DirectHapticDevice> device_ = std::make_unique<sim::DirectHapticDevice>(kRange);
 };
 
 // The PIO window: a memfd mapped twice, the device's side through sim::PioDeviceLink.
@@ -122,6 +127,9 @@ class PioBackend final : public BackendUnderTest {
   }
   [[nodiscard]] bool carries_host_heartbeat() const override { return true; }
   [[nodiscard]] bool carries_non_finite() const override { return false; }
+  void restart_host(const hal::HapticRange& range) override {
+    backend_ = std::make_unique<pio::PioHapticDevice>(&windows_.host->window(), range);
+  }
 
  private:
   test::WindowPair windows_ = test::make_device_window();
@@ -134,7 +142,7 @@ class PioBackend final : public BackendUnderTest {
 class CanBackend final : public BackendUnderTest {
  public:
   CanBackend() { CHECK_TRUE(sockets_.open()); }
-  hal::HapticDevice& host() override { return backend_; }
+  hal::HapticDevice& host() override { return *backend_; }
   void publish(const hal::HapticSample& sample) override { link_.publish(sample); }
   // A pose travels as two frames; a lost frame pairs the PoseA of one sample with the PoseB of another.
   std::optional<HapticFault> tear(const hal::HapticSample& sample) override {
@@ -159,11 +167,15 @@ class CanBackend final : public BackendUnderTest {
   }
   [[nodiscard]] bool carries_host_heartbeat() const override { return true; }
   [[nodiscard]] bool carries_non_finite() const override { return false; }
+  void restart_host(const hal::HapticRange& range) override {
+    backend_ = std::make_unique<can::SocketCanHapticDevice>(&sockets_.host, range);
+  }
 
  private:
   test::CanSocketPair sockets_;
   sim::CanDeviceLink link_{sockets_.device};
-  can::SocketCanHapticDevice backend_{&sockets_.host, kRange};
+  std::unique_ptr<can::SocketCanHapticDevice> backend_ =
+      std::make_unique<can::SocketCanHapticDevice>(&sockets_.host, kRange);
   sim::DeviceCommand command_{};
 };
 
@@ -494,6 +506,25 @@ void force_and_torque_are_clamped_to_their_limits(Contract& contract) {
   CHECK_EQUAL(2U, contract.host().counters().commands_clamped);
 }
 
+// The limits are the board's (HapticRange), not a number built into the backend: a board that
+// allows 2 N and 50 N.mm gets no more, whatever the device itself would take.
+void a_boards_lower_limits_are_the_ones_clamped_to(Contract& contract) {
+  hal::HapticRange gentle = kRange;
+  gentle.force_limit_n = 2.0;
+  gentle.torque_limit_nmm = 50.0;
+  contract.backend().restart_host(gentle);
+  contract.bring_up();
+  hal::HapticCommand command = test::command_of(0.0, 0.0, -4.0);
+  command.torque_nmm[0] = 100.0;
+  CHECK_EQUAL(WriteStatus::Clamped, contract.host().write_command(command).status);
+  const sim::DeviceCommand driven = contract.backend().device_command();
+  CHECK_TRUE(driven.enable);
+  DOUBLES_EQUAL(-2.0, driven.force_n[2], 1e-3);
+  DOUBLES_EQUAL(50.0, driven.torque_nmm[0], 0.011);
+  CHECK_EQUAL(WriteStatus::Written, contract.host().write_command(test::command_of(0.0, 1.5, 0.0)).status);
+  DOUBLES_EQUAL(1.5, contract.backend().device_command().force_n[1], 1e-3);
+}
+
 // A NaN or infinity in a command sends zero force with enable off in its place, counted, not latched.
 void a_command_that_is_not_finite_sends_zero_force_with_enable_off(Contract& contract) {
   contract.bring_up();
@@ -580,6 +611,7 @@ HAPTIC_CONTRACT_CASE(ATornSampleIsRefusedAndTheNextWholeOneGiven, a_torn_sample_
 HAPTIC_CONTRACT_CASE(ACommandWithinTheRangeReachesTheDeviceAsGiven,
                      a_command_within_the_range_reaches_the_device_as_given)
 HAPTIC_CONTRACT_CASE(ForceAndTorqueAreClampedToTheirLimits, force_and_torque_are_clamped_to_their_limits)
+HAPTIC_CONTRACT_CASE(ABoardsLowerLimitsAreTheOnesClampedTo, a_boards_lower_limits_are_the_ones_clamped_to)
 HAPTIC_CONTRACT_CASE(ACommandThatIsNotFiniteSendsZeroForceWithEnableOff,
                      a_command_that_is_not_finite_sends_zero_force_with_enable_off)
 HAPTIC_CONTRACT_CASE(EveryWriteBeatsTheHostHeartbeat, every_write_beats_the_host_heartbeat)
