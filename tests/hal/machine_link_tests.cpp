@@ -241,10 +241,12 @@ void AMoveIsDoneAndTheCommandedStepsAreItsTarget(MachineLinkBackend& backend) {
   const MachineSteps home = backend.machine_steps();
   CHECK(link.set_spindle(true, backend.in(kUpdateBoundNs)).done);
   const std::uint64_t moves_before = link.status().moves_done;
+  const std::uint64_t sent_before = backend.sent();
   const MachineResult first = link.move(target(3, -2, 4, {2, 0, 1}, true), backend.in(kUpdateBoundNs));
   CHECK(first.done);
   check_steps({3, -2, 4}, link.status().commanded_steps);
   check_steps({3, -2, 4}, difference(backend.machine_steps(), home));
+  CHECK(backend.sent() > sent_before);  // the probe the refusal cases rely on sees a move
   // Targets are absolute: the second move goes to (5, 1, 4), not by it.
   CHECK(link.move(target(5, 1, 4, {1, 0, 2}, false), backend.in(kUpdateBoundNs)).done);
   check_steps({5, 1, 4}, link.status().commanded_steps);
