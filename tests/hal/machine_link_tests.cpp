@@ -483,6 +483,24 @@ void AbortOnsFlagMakesStartGiveUpAborted(MachineLinkBackend& backend) {
   CHECK_FALSE(backend.machine_drivers_on());
 }
 
+// The MMC-4S board's latches keep the outputs across a program's restart (and the chip's "I"): a
+// start that gives up must still leave them off, as a start that completes does.
+void AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn(MachineLinkBackend& backend) {
+  MachineLink& link = backend.link();
+  std::atomic<bool> stop_asked{false};
+  link.abort_on(&stop_asked);
+  start_and_home(backend);
+  CHECK(link.set_spindle(true, backend.in(kUpdateBoundNs)).done);
+  CHECK(link.move(target(1, 1, 1, {0, 1, 2}, true), backend.in(kUpdateBoundNs)).done);
+  CHECK(backend.machine_spindle_on());
+  stop_asked.store(true);  // the next run's operator asks for a stop while the mill wakes
+  check_refused(link.start(backend.in(2'000 * kMs)), MachineRefusal::Aborted);
+  CHECK_FALSE(backend.machine_spindle_on());
+  CHECK_FALSE(backend.machine_drivers_on());
+  CHECK_FALSE(link.status().spindle_on);
+  CHECK_FALSE(link.status().drivers_on);
+}
+
 }  // namespace contract
 
 // ---- Every case for every backend.
@@ -495,6 +513,11 @@ void AbortOnsFlagMakesStartGiveUpAborted(MachineLinkBackend& backend) {
   TEST(MachineLinkContractOnSpy, name) {   \
     SpyBackend backend;                    \
     contract::name(backend);               \
+  }
+#define MACHINE_LINK_CONTRACT_IGNORED_ON_CY545(name) \
+  IGNORE_TEST(MachineLinkContractOnCy545, name) {    \
+    Cy545Backend backend;                            \
+    contract::name(backend);                         \
   }
 #define MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(name) \
   IGNORE_TEST(MachineLinkContractOnSpy, name) {    \
@@ -565,3 +588,11 @@ MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AbortOnsFlagMakesHomeGiveUpAborted)
 MACHINE_LINK_CONTRACT_ON_CY545(AbortOnsFlagMakesStartGiveUpAborted)
 // spy: ignores abort_on's flag (start() is done)
 MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AbortOnsFlagMakesStartGiveUpAborted)
+
+// cy545: a bug. Cy545Link::start() gives up on the flag in its wake-up loop (hal/cy545/cy545_link.cpp,
+// `if (abort_asked()) return refuse(MachineRefusal::Aborted);`) before it turns any output off, so the
+// spindle and drivers an earlier run latched on stay on; the contract says "give up (refusal Aborted,
+// outputs off)", and MachineSide::home() does not stop after a failed start. Enable once fixed.
+MACHINE_LINK_CONTRACT_IGNORED_ON_CY545(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
+// spy: ignores abort_on's flag (start() is done) and has no outputs of its own
+MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
