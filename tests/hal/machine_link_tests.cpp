@@ -414,7 +414,7 @@ void EveryCallReturnsByItsDeadline(MachineLinkBackend& backend) {
   CHECK(link.set_spindle(true, deadline).done);
   check_by("set_spindle", deadline);
   for (std::int32_t x = 1; x <= 5; ++x) {
-    deadline = backend.in(60 * kMs);  // 2 updates' time for a move of 6 steps
+    deadline = backend.in(60 * kMs);  // two updates' time for a move of 2 steps
     CHECK(link.move(target(x, x, 0, {0, 1, 2}, true), deadline).done);
     check_by("move", deadline);
   }
