@@ -589,10 +589,7 @@ MACHINE_LINK_CONTRACT_ON_CY545(AbortOnsFlagMakesStartGiveUpAborted)
 // spy: ignores abort_on's flag (start() is done)
 MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AbortOnsFlagMakesStartGiveUpAborted)
 
-// cy545: a bug. Cy545Link::start() gives up on the flag in its wake-up loop (hal/cy545/cy545_link.cpp,
-// `if (abort_asked()) return refuse(MachineRefusal::Aborted);`) before it turns any output off, so the
-// spindle and drivers an earlier run latched on stay on; the contract says "give up (refusal Aborted,
-// outputs off)", and MachineSide::home() does not stop after a failed start. Enable once fixed.
-MACHINE_LINK_CONTRACT_IGNORED_ON_CY545(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
+// Found by this case: start() gave up in its wake-up loop before turning any output off.
+MACHINE_LINK_CONTRACT_ON_CY545(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
 // spy: ignores abort_on's flag (start() is done) and has no outputs of its own
 MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
