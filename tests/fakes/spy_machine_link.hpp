@@ -15,7 +15,8 @@
 // at once (status().moves_done counts it before move() returns, unless complete_moves_at_once is
 // cleared), no call is refused DeadlineTooShort or TooLong (unless max_move_steps is set), homing
 // takes no time (so homing_bound_ns() is a token 1 s), keep_alive() is counted but toggles nothing,
-// start() never blocks, and abort_on()'s flag is only stored. bytes_sent and bytes_received stay 0.
+// start() never blocks, and abort_on()'s flag is looked at once per start() or homing call (given up
+// there: outputs off, Stopped, refusal Aborted). bytes_sent and bytes_received stay 0.
 // A scripted answer replaces the contract's for one call of its kind (see answer_next()).
 #pragma once
 
@@ -138,8 +139,8 @@ class SpyMachineLink final : public hal::MachineLink {
     if (!scripted(MachineCall::Start, result)) {
       if (faulted()) {
         result = refuse(hal::MachineRefusal::Faulted);
-      } else if (abort_ != nullptr && abort_->load()) {
-        result = refuse(hal::MachineRefusal::Aborted);
+      } else if (abort_asked()) {
+        result = aborted();  // as the CY545 link: what an earlier run left on is turned off first
       } else {
         accept_start();
       }
@@ -247,6 +248,15 @@ class SpyMachineLink final : public hal::MachineLink {
     calls_.push_back(call);
     return call.result;
   }
+  [[nodiscard]] bool abort_asked() const { return abort_ != nullptr && abort_->load(); }
+  // A stop asked while starting or homing: outputs off, stopped, home again (refusal Aborted).
+  hal::MachineResult aborted() {
+    status_.state = hal::MachineState::Stopped;
+    status_.homed = false;
+    status_.spindle_on = false;
+    status_.drivers_on = false;
+    return refuse(hal::MachineRefusal::Aborted);
+  }
   void accept_start() {
     status_.state = hal::MachineState::Ready;
     status_.homed = false;
@@ -256,9 +266,10 @@ class SpyMachineLink final : public hal::MachineLink {
   hal::MachineResult homing(MachineCall kind, hal::MonotonicNs deadline_ns) {
     hal::MachineResult result = done();
     if (!scripted(kind, result)) {
-      result = faulted()    ? refuse(hal::MachineRefusal::Faulted)
-               : started() ? done()
-                           : refuse(hal::MachineRefusal::NotHomed);
+      result = faulted()       ? refuse(hal::MachineRefusal::Faulted)
+               : !started()    ? refuse(hal::MachineRefusal::NotHomed)
+               : abort_asked() ? aborted()
+                               : done();
     }
     if (result.done) {
       status_.state = hal::MachineState::Homed;

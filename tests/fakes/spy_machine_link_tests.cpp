@@ -271,12 +271,20 @@ TEST(SpyMachineLink, AStopThatCannotConfirmTheOutputsOffLeavesThemAsTheyWere) {
   CHECK_FALSE(status.homed);
 }
 
-TEST(SpyMachineLink, AnAbortAskedBeforeStartIsRefusedAborted) {
+TEST(SpyMachineLink, AnAbortAskedBeforeStartOrHomingIsRefusedAbortedWithTheOutputsOff) {
   test::SpyMachineLink link;
-  const std::atomic<bool> abort{true};
+  std::atomic<bool> abort{true};
   link.abort_on(&abort);
   check_refused(hal::MachineRefusal::Aborted, link.start(kDeadline));
-  CHECK(link.status().state == hal::MachineState::Open);
+  CHECK(link.status().state == hal::MachineState::Stopped);
+  CHECK_FALSE(link.status().spindle_on);
+  CHECK_FALSE(link.status().drivers_on);
+  abort.store(false);
+  CHECK(link.start(kDeadline).done);
+  abort.store(true);
+  check_refused(hal::MachineRefusal::Aborted, link.home(kDeadline));
+  CHECK(link.status().state == hal::MachineState::Stopped);
+  CHECK_FALSE(link.status().homed);
 }
 
 TEST(SpyMachineLink, ReportsTheHomingApproachItIsGiven) {

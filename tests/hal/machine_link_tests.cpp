@@ -146,18 +146,38 @@ struct SpyBackend final : MachineLinkBackend {
   MonotonicNs now_ns() override { return time_ns; }
   void wait_ns(MonotonicNs ns) override { time_ns += ns; }
   std::uint64_t sent() override { return spy.moves().size(); }
+  // Where the motors are: the spy's targets count from the last home, so walk its calls (home()
+  // goes to step 0 of the machine; declare_home() makes where it stands the new step 0).
   MachineSteps machine_steps() override {
-    if (spy.moves().empty()) {
-      return {0, 0, 0};
+    MachineSteps at{0, 0, 0};
+    MachineSteps origin{0, 0, 0};
+    for (const test::SpyCall& call : spy.calls()) {
+      if (!call.result.done) {
+        continue;
+      }
+      if (call.kind == test::MachineCall::Home) {
+        at = origin = {0, 0, 0};
+      } else if (call.kind == test::MachineCall::DeclareHome) {
+        origin = at;
+      } else if (call.kind == test::MachineCall::Move) {
+        for (std::size_t axis = 0; axis < 3; ++axis) {
+          at[axis] = origin[axis] + call.target.motor_steps[axis];
+        }
+      }
     }
-    const std::array<std::int32_t, 3>& steps = spy.moves().back().motor_steps;
-    return {steps[0], steps[1], steps[2]};
+    return at;
   }
   bool machine_spindle_on() override { return spy.status().spindle_on; }
   bool machine_drivers_on() override { return spy.status().drivers_on; }
-  // Today's spy has no scripted faults: the upgraded spy's go here.
-  bool silence_controller() override { return false; }
-  bool garble_replies() override { return false; }
+  // The spy's scripted faults: its next query answers as the CY545 link's would.
+  bool silence_controller() override {
+    spy.fail_next(test::MachineCall::Verify, MachineFault::Timeout);
+    return true;
+  }
+  bool garble_replies() override {
+    spy.fail_next(test::MachineCall::Verify, MachineFault::GarbledReply);
+    return true;
+  }
 };
 
 MachineTarget target(std::int32_t x, std::int32_t y, std::int32_t z, std::array<std::uint8_t, 3> order, bool cutting) {
@@ -532,19 +552,16 @@ MACHINE_LINK_CONTRACT_ON_CY545(StartThenHomeGivesHomed)
 MACHINE_LINK_CONTRACT_ON_SPY(StartThenHomeGivesHomed)
 
 MACHINE_LINK_CONTRACT_ON_CY545(MovesBeforeHomingAreRefusedNotHomedAndSendNothing)
-// spy: accepts and records a move before homing (move() only checks for a hold)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(MovesBeforeHomingAreRefusedNotHomedAndSendNothing)
+MACHINE_LINK_CONTRACT_ON_SPY(MovesBeforeHomingAreRefusedNotHomedAndSendNothing)
 
 MACHINE_LINK_CONTRACT_ON_CY545(AMoveIsDoneAndTheCommandedStepsAreItsTarget)
 MACHINE_LINK_CONTRACT_ON_SPY(AMoveIsDoneAndTheCommandedStepsAreItsTarget)
 
 MACHINE_LINK_CONTRACT_ON_CY545(ABadTargetIsRefusedBadTargetAndSendsNothing)
-// spy: accepts any order and any step count
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(ABadTargetIsRefusedBadTargetAndSendsNothing)
+MACHINE_LINK_CONTRACT_ON_SPY(ABadTargetIsRefusedBadTargetAndSendsNothing)
 
 MACHINE_LINK_CONTRACT_ON_CY545(ACuttingMoveWithTheSpindleOffIsRefusedSpindleOff)
-// spy: has no spindle interlock (a cutting move with the spindle off is done)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(ACuttingMoveWithTheSpindleOffIsRefusedSpindleOff)
+MACHINE_LINK_CONTRACT_ON_SPY(ACuttingMoveWithTheSpindleOffIsRefusedSpindleOff)
 
 MACHINE_LINK_CONTRACT_ON_CY545(HoldRefusesMovesUntilResume)
 MACHINE_LINK_CONTRACT_ON_SPY(HoldRefusesMovesUntilResume)
@@ -553,16 +570,13 @@ MACHINE_LINK_CONTRACT_ON_CY545(StopTurnsTheSpindleOffAndLeavesTheLinkStopped)
 MACHINE_LINK_CONTRACT_ON_SPY(StopTurnsTheSpindleOffAndLeavesTheLinkStopped)
 
 MACHINE_LINK_CONTRACT_ON_CY545(StopTurnsTheDriversOff)
-// spy: drivers_on is true from construction and stop() leaves it so
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(StopTurnsTheDriversOff)
+MACHINE_LINK_CONTRACT_ON_SPY(StopTurnsTheDriversOff)
 
 MACHINE_LINK_CONTRACT_ON_CY545(AfterAStopMovesAreRefusedUntilHomedAgain)
-// spy: stop() leaves homed true and a move after it is done (and resume() makes it Homed again)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AfterAStopMovesAreRefusedUntilHomedAgain)
+MACHINE_LINK_CONTRACT_ON_SPY(AfterAStopMovesAreRefusedUntilHomedAgain)
 
 MACHINE_LINK_CONTRACT_ON_CY545(DeclaredHomeMakesWhereTheToolStandsStepZero)
-// spy: home() and declare_home() keep the last commanded steps instead of making them 0
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(DeclaredHomeMakesWhereTheToolStandsStepZero)
+MACHINE_LINK_CONTRACT_ON_SPY(DeclaredHomeMakesWhereTheToolStandsStepZero)
 
 MACHINE_LINK_CONTRACT_ON_CY545(VerifyAfterMovesIsDone)
 MACHINE_LINK_CONTRACT_ON_SPY(VerifyAfterMovesIsDone)
@@ -574,22 +588,17 @@ MACHINE_LINK_CONTRACT_ON_CY545(EveryCallReturnsByItsDeadline)
 MACHINE_LINK_CONTRACT_ON_SPY(EveryCallReturnsByItsDeadline)
 
 MACHINE_LINK_CONTRACT_ON_CY545(AControllerThatStopsAnsweringIsAFaultByTheDeadline)
-// spy: cannot script a controller that stops answering (no scripted faults; SpyBackend::silence_controller)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AControllerThatStopsAnsweringIsAFaultByTheDeadline)
+MACHINE_LINK_CONTRACT_ON_SPY(AControllerThatStopsAnsweringIsAFaultByTheDeadline)
 
 MACHINE_LINK_CONTRACT_ON_CY545(ALatchedFaultRefusesMovesAndHomingFaulted)
-// spy: cannot script a garbled reply or any fault latch (SpyBackend::garble_replies)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(ALatchedFaultRefusesMovesAndHomingFaulted)
+MACHINE_LINK_CONTRACT_ON_SPY(ALatchedFaultRefusesMovesAndHomingFaulted)
 
 MACHINE_LINK_CONTRACT_ON_CY545(AbortOnsFlagMakesHomeGiveUpAborted)
-// spy: ignores abort_on's flag (home() is done)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AbortOnsFlagMakesHomeGiveUpAborted)
+MACHINE_LINK_CONTRACT_ON_SPY(AbortOnsFlagMakesHomeGiveUpAborted)
 
 MACHINE_LINK_CONTRACT_ON_CY545(AbortOnsFlagMakesStartGiveUpAborted)
-// spy: ignores abort_on's flag (start() is done)
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AbortOnsFlagMakesStartGiveUpAborted)
+MACHINE_LINK_CONTRACT_ON_SPY(AbortOnsFlagMakesStartGiveUpAborted)
 
 // Found by this case: start() gave up in its wake-up loop before turning any output off.
 MACHINE_LINK_CONTRACT_ON_CY545(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
-// spy: ignores abort_on's flag (start() is done) and has no outputs of its own
-MACHINE_LINK_CONTRACT_IGNORED_ON_SPY(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
+MACHINE_LINK_CONTRACT_ON_SPY(AnAbortedStartLeavesOffTheOutputsAnEarlierRunLeftOn)
