@@ -10,6 +10,8 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <map>
+#include <utility>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -204,6 +206,48 @@ TEST(LeafContacts, ALeafAcrossSeveralOfTheTreesTestsIsSettledPointByPoint) {
   const std::uint32_t penetrating = check_against_the_tree(tool, points, leaf);
   CHECK(penetrating > 0);
   CHECK(penetrating < 32);
+}
+
+TEST(LeafContacts, TheDeepestOfPointsTheFloatsCannotTellApartIsFoundInDoublePrecision) {
+  // Two points inside the ball whose lane depths are the same float but whose depths are not.
+  LeafPoints pair(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 2);
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(
+      tool, geometry::upright_meridian_box(kTip, kTip + Eigen::Vector3d(0.1, 0.0, 0.5), kTip + Eigen::Vector3d(0.4, 0.3, 0.8)));
+  CHECK(cover.cover == geometry::BoxCover::Region);
+  // Candidates by their lane depth: the first two with one float depth and two double ones.
+  std::map<float, std::pair<tables::PackedPoint, double>> seen;
+  bool found = false;
+  tables::PackedPoint first{}, second{};
+  for (int i = 0; i < 20000 && !found; ++i) {
+    const double t = static_cast<double>(i);
+    const Eigen::Vector3d p = kTip + Eigen::Vector3d(0.25 + 0.15 * std::sin(1.3 * t), 0.15 + 0.15 * std::cos(0.7 * t),
+                                                     0.65 + 0.15 * std::sin(2.9 * t));
+    pair.points[0] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    load_leaf(pair.part, 0, 1, kTip, leaf);
+    CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+    const auto [at, added] = seen.emplace(leaf.depth[0], std::make_pair(pair.points[0], leaf.max_depth_mm));
+    if (!added && at->second.second < leaf.max_depth_mm) {
+      first = at->second.first;  // the shallower first
+      second = pair.points[0];
+      found = true;
+    }
+  }
+  CHECK_TEXT(found, "no two points with the same float depth among the candidates");
+  pair.points[0] = first;
+  pair.points[1] = second;
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  DOUBLES_EQUAL(double{leaf.depth[0]}, double{leaf.depth[1]}, 0.0);
+  check_against_the_tree(tool, pair, leaf);  // the deepest lane and depth: the double-precision ones
+  std::swap(pair.points[0], pair.points[1]);
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  check_against_the_tree(tool, pair, leaf);
+  // A true tie: the first lane at the deepest depth.
+  pair.points[1] = pair.points[0];
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  LONGS_EQUAL(0, leaf.deepest_lane);
 }
 
 TEST(LeafContacts, ADamagedToolTreeIsAFaultNotANumber) {

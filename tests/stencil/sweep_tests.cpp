@@ -84,8 +84,12 @@ TEST(Sweep, ALongMoveStopsAfterItsStepLimitAllLegal) {
   CHECK(r.status == SweepStatus::Limited);
   LONGS_EQUAL(7, r.steps);
   CHECK((r.reached_mm - Eigen::Vector3d(5.875, 5.0, 10.0)).norm() < 1e-12);  // seven full sub-steps
-  // Exactly as many sub-steps as the limit still reaches the target.
-  CHECK(check_sweep(part, from, Eigen::Vector3d(5.875, 5.0, 10.0), 0.125, 7).status == SweepStatus::Legal);
+  // Exactly as many sub-steps as the limit still reaches the target, the last one shorter.
+  const Eigen::Vector3d near(5.3, 5.0, 10.0);  // 2.4 sub-steps: three
+  const SweepResult exact = check_sweep(part, from, near, 0.125, 3);
+  CHECK(exact.status == SweepStatus::Legal);
+  LONGS_EQUAL(3, exact.steps);
+  CHECK(exact.reached_mm == near);
 }
 
 TEST(Sweep, BadInputIsAFaultWithNothingChecked) {
