@@ -168,14 +168,11 @@ TEST(LeafContacts, TheLanesHoldEachPointsOffsetFromTheTipAndRepeatTheLastPastThe
   check_loaded(points, kTip, leaf);
 }
 
-// BUG (left for the owner, not fixed here): with GCC 12.2 at -O2 and above, the SLP vectoriser
-// folds load_leaf's `tip.x() - double{high[0]}` and `tip.y() - double{high[1]}` to tip - tip = 0
-// (leaf_contacts.cpp:339-340; the object code has `vsubpd %xmm1,%xmm1,%xmm1`; -fno-tree-slp-vectorize
-// or -O1 gives the right numbers; z, converted on its own, is right). So for a tip that is not a
-// float, x and y lose the part of the tip below a float's precision: off by up to half a float ulp
-// of the tip (1.9e-6 mm here; 7.6e-6 mm beyond 128 mm), where the comment promises a rounding of
-// the offset's own size. Un-ignore once load_leaf keeps `low`.
-IGNORE_TEST(LeafContacts, AnOffsetFromATipThatIsNotAFloatIsRightToARoundingOfItsOwnSize) {
+// A tip that is not a float: its rest below a float's precision must reach the offsets. Written
+// as `tip - double(float(tip))`, GCC 12.2's SLP vectoriser folded the rest of x and y to 0 (the
+// object code had `vsubpd %xmm1,%xmm1,%xmm1`): off by up to half a float ulp of the tip (1.9e-6 mm
+// here; 7.6e-6 mm beyond 128 mm), where the comment promises a rounding of the offset's own size.
+TEST(LeafContacts, AnOffsetFromATipThatIsNotAFloatIsRightToARoundingOfItsOwnSize) {
   const Eigen::Vector3d tip(123.456789, 78.9012345, 10.0625);
   const LeafPoints points(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d(0.2, 0.2, 0.2), 5, tip);
   load_leaf(points.part, 0, points.count, tip, leaf);
