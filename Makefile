@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour fresh-check package package-check clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour mutation-check fresh-check package package-check clean help
 
 all: build
 
@@ -18,6 +18,7 @@ help:
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
 	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
+	@echo "make mutation-check each behaviour in tests/mutations.tsv broken by a one-line change: its test must fail (build/mutation; about 15 minutes)"
 	@echo "make package    the Debian package (CPack): build/stencil_<version>_<arch>.deb"
 	@echo "make package-check install, use and purge that package in a clean Debian 12 root (mmdebstrap; needs root; about two minutes)"
 	@echo "make fresh-check README's two commands in a clean Debian 12 root (mmdebstrap; needs root; about half an hour)"
@@ -103,6 +104,12 @@ fuzz: deps
 # A check for refactors: OLD's stencil-sim (built in a worktree under build/same-behaviour/old) and this
 # tree's run make demo's job and sim_cli.sh's cases on the virtual clock; their reports and journals
 # must be the same apart from the wall clock (toolchain/same-behaviour.sh).
+# A check of the tests, not a test: each row of tests/mutations.tsv breaks one behaviour README names
+# with a one-line change to the source, on a copy of the tree; the test named must then fail
+# (toolchain/mutation-check.sh; prints the table).
+mutation-check: deps
+	bash toolchain/mutation-check.sh build/mutation
+
 same-behaviour:
 	@test -n "$(OLD)" || { echo "usage: make same-behaviour OLD=<commit>" >&2; exit 2; }
 	@$(MAKE) --no-print-directory build

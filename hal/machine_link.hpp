@@ -88,7 +88,9 @@ class MachineLink {
   // from there; the slack of every axis is on the side homing approached from (reported by
   // home_approach()). The deadline should allow homing_bound_ns().
   // Set before start(): start() and home() look at *flag between commands and give up (refusal
-  // Aborted, outputs off) once it is true: a stop asked for while homing is taken within one step.
+  // Aborted, outputs off) once it is true: a stop asked for while homing is taken within one step;
+  // one asked while starting once start() has turned off what an earlier run left latched on (the
+  // wake-up and start-up are bounded by start()'s deadline).
   virtual void abort_on(const std::atomic<bool>* flag) = 0;
   // The longest homing can take from anywhere in the travel (ns): the caller's deadline for it.
   [[nodiscard]] virtual MonotonicNs homing_bound_ns() const = 0;

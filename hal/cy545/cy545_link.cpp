@@ -320,9 +320,8 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
     if (clock_.now_ns() >= deadline_ns) {
       break;
     }
-    if (abort_asked()) {
-      return refuse(MachineRefusal::Aborted);
-    }
+    // No stop taken here: whatever an earlier run left latched on (the spindle) is turned off only
+    // once the chip answers, below; a stop asked meanwhile is taken after that.
     const PortIo io = port_.write_all("\r", deadline_ns, clock_);
     bytes_sent_ += 1;
     if (io == PortIo::Closed) {
@@ -380,6 +379,11 @@ MachineResult Cy545Link::start(MonotonicNs deadline_ns) {
   spindle_on_ = false;
   homed_ = false;
   rate_sent_ = config_.motion.step_rate;
+  if (abort_asked()) {  // asked while the chip woke or started: taken now the outputs are off
+    state_ = MachineState::Stopped;
+    std::snprintf(last_error_, sizeof last_error_, "start stopped as asked; spindle and drivers off");
+    return refuse(MachineRefusal::Aborted);
+  }
   state_ = MachineState::Ready;
   return {true, MachineRefusal::None, MachineFault::None};
 }

@@ -239,6 +239,32 @@ TEST(Controller, AMachineFaultEntersTheSafeState) {
   check_safe(bench, SafeReason::MachineFault);
 }
 
+// The machine side's journal failed (a target it could not write within the bound): nothing after
+// it would be recorded, so the run ends there and no reset brings the cycle back.
+TEST(Controller, AJournalFailureTheMachineSideReportsEntersTheSafeStateForGood) {
+  Bench bench;
+  bench.cycles(20);
+  CHECK(bench.machine_events.push({.kind = MachineEventKind::JournalFailed}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::JournalFailed);
+  CHECK(bench.controller->safe_source() == CommandSource::Machine);
+  bench.cycles(600);  // the hand held still near the tool: a reset would be taken after any other fault
+  CHECK(bench.display_commands.push({CommandKind::Reset, 0.0, CommandSource::Display}));
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  CHECK(bench.events.back().outcome == CommandOutcome::RunEnding);
+  LONGS_EQUAL(0, bench.controller->counters().resets_accepted);
+}
+
+// The engine cannot give a force (here the force limit is not a number): zero force in that very
+// cycle, the reason the engine's.
+TEST(Controller, AForceTheEngineCannotComputeEntersTheSafeStateAsAnEngineFault) {
+  ControllerConfig c = config();
+  c.haptic.max_force_n = std::numeric_limits<double>::quiet_NaN();
+  Bench bench(c);
+  CHECK(bench.cycle() == CycleStatus::SafeState);
+  check_safe(bench, SafeReason::EngineFault);
+}
+
 TEST(Controller, AMachineSideThatFallsAWholeRingBehindEntersTheSafeState) {
   Bench bench;
   bench.drain_machine = false;

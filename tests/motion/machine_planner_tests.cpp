@@ -1,6 +1,5 @@
-// The machine side: frames, the virtual tool's speed limit, and the waypoint planner against the
-// hex prism, with the mill's staircase checked independently at a fine pitch and a deadband model
-// of backlash standing in for the real screws.
+// The waypoint planner against the hex prism, with the mill's staircase checked independently at a
+// fine pitch and a deadband model of backlash standing in for the real screws.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -146,41 +145,6 @@ std::vector<Eigen::Vector3d> virtual_path(const tables::PartTables& part, const 
 }
 
 }  // namespace
-
-TEST_GROUP(MachineFrames){};
-
-TEST(MachineFrames, TheSherlinesTableAxesCountAgainstTheWorldAndStepsRoundTrip) {
-  const MachineFrames frames = sherline_frames();
-  MachineSteps steps{};
-  CHECK(world_to_steps(frames, kHome + Eigen::Vector3d(1.0, 0.5, -2.0), steps));
-  CHECK_EQUAL(-640, steps.axis[0]);  // the tool goes +x: the table goes -x
-  CHECK_EQUAL(-320, steps.axis[1]);
-  CHECK_EQUAL(-1280, steps.axis[2]);
-  const Eigen::Vector3d back = steps_to_world(frames, steps);
-  CHECK((back - (kHome + Eigen::Vector3d(1.0, 0.5, -2.0))).norm() < 1e-12);
-  CHECK(world_to_steps(frames, kHome + Eigen::Vector3d(0.0007, -0.0008, 0.0), steps));  // nearest step
-  CHECK_EQUAL(0, steps.axis[0]);
-  CHECK_EQUAL(1, steps.axis[1]);
-  CHECK_FALSE(world_to_steps(frames, Eigen::Vector3d(NAN, 0.0, 0.0), steps));
-  CHECK_FALSE(world_to_steps(frames, Eigen::Vector3d(1e5, 0.0, 0.0), steps));  // beyond 24 bits of steps
-  const Eigen::Vector3d world = device_to_world(frames, Eigen::Vector3d(250.0, 125.0, 200.0));
-  CHECK((world - Eigen::Vector3d(25.0, 12.5, 20.0)).norm() < 1e-12);
-  CHECK((world_to_device(frames, world) - Eigen::Vector3d(250.0, 125.0, 200.0)).norm() < 1e-12);
-}
-
-TEST_GROUP(SpeedLimit){};
-
-TEST(SpeedLimit, NoAxisFasterThanTheMillAndAllAxesTogetherWithinTheStepRate) {
-  const MachineSpeed speed{1.4, 1000.0, 640.0};
-  const Eigen::Vector3d along_x = limit_tool_move(speed, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 0, 0), 0.001);
-  DOUBLES_EQUAL(0.0014, along_x.x(), 1e-15);
-  const Eigen::Vector3d diagonal = limit_tool_move(speed, Eigen::Vector3d::Zero(), Eigen::Vector3d(1, 1, 1), 0.001);
-  DOUBLES_EQUAL(1000.0 / 640.0 * 0.001, diagonal.cwiseAbs().sum(), 1e-15);  // the step rate binds
-  DOUBLES_EQUAL(diagonal.x(), diagonal.z(), 1e-18);                          // direction kept
-  const Eigen::Vector3d slow(0.0001, 0.0, -0.0002);
-  CHECK(limit_tool_move(speed, Eigen::Vector3d::Zero(), slow, 0.001) == slow);
-  CHECK(limit_tool_move(speed, Eigen::Vector3d::Ones(), Eigen::Vector3d(NAN, 0, 0), 0.001) == Eigen::Vector3d::Ones());
-}
 
 TEST_GROUP(MachinePlanner){};
 

@@ -7,7 +7,6 @@
 
 #include <Eigen/Geometry>
 
-#include "firmware/core/stencil/haptic_force.hpp"
 #include "firmware/core/stencil/sweep.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
@@ -213,27 +212,4 @@ TEST(VirtualTool, ANonFiniteDesiredPoseIsAFaultAndTheToolStays) {
   const RemediationResult result = tool.step({std::numeric_limits<double>::quiet_NaN(), 1.0, 1.0}, ContactParameters{});
   CHECK(result.status == RemediationStatus::Fault);
   CHECK(tool.tip_mm() == kHome);
-}
-
-TEST_GROUP(HapticOutput){};
-
-TEST(HapticOutput, CouplingPullsTowardsTheVirtualToolAndIsClampedAtFiveNewtons) {
-  const ContactResult none{QueryStatus::Ok, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
-  const HapticLimits limits{};
-  const HapticOutput small = haptic_output({0, 0, 0}, {0.1, 0, 0}, none, limits);
-  CHECK((small.force_n - Eigen::Vector3d(0.5, 0, 0)).norm() < 1e-12);  // 0.5 N/mm x 1 device mm
-  CHECK_FALSE(small.clamped);
-  const HapticOutput large = haptic_output({0, 0, 0}, {0, 3.0, 0}, none, limits);
-  DOUBLES_EQUAL(5.0, large.force_n.norm(), 1e-12);
-  CHECK(large.clamped);
-  CHECK(large.force_n.normalized().dot(Eigen::Vector3d::UnitY()) > 0.999999);
-}
-
-TEST(HapticOutput, ANonFiniteInputGivesZeroAndAFault) {
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  ContactResult contact{QueryStatus::Ok, 1, 0.1, 0, Eigen::Vector3d(0, 0, nan), Eigen::Vector3d::Zero()};
-  const HapticOutput out = haptic_output({0, 0, 0}, {0, 0, 0}, contact, HapticLimits{});
-  CHECK(out.fault);
-  CHECK(out.force_n == Eigen::Vector3d::Zero());
-  CHECK(haptic_output({nan, 0, 0}, {0, 0, 0}, ContactResult{}, HapticLimits{}).fault);
 }

@@ -1,0 +1,306 @@
+// One leaf against the upright tool, lane by lane (stencil/leaf_contacts.hpp), checked point by
+// point against the tool tree itself (geometry::classify_meridian and classify_at_pose, in double
+// precision): the offsets loaded into the lanes, each way a leaf is settled (inside one region,
+// straddling its surface, split at a plane of the tree, mixed), the deepest point, the lanes past
+// the leaf's end, a damaged tree, and the force sums. The tool is the default 3 mm ball end mill
+// under a 10 mm holder, its tip far from the origin (at a point a float holds exactly: see the
+// ignored case below for one it does not).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <utility>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "firmware/core/geometry/meridian_box.hpp"
+#include "firmware/core/geometry/tool_bsp.hpp"
+#include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/stencil/leaf_contacts.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::engine;
+
+namespace {
+
+const Eigen::Vector3d kTip(123.4375, 78.90625, 10.0625);
+constexpr geometry::ToolSpec kBall{geometry::CutterKind::Ball, 3.0, 12.0, 0.0, 10.0, 20.0};
+
+// A leaf's points in a box around `centre` (offsets from the tip), spread over it by a fixed
+// pattern, with normals pointing every which way (unit, never along the axis alone).
+struct LeafPoints {
+  std::array<tables::PackedPoint, tables::kMaxLeafPoints> points{};
+  std::array<tables::PackedPoint, tables::kMaxLeafPoints> normals{};
+  tables::PartTables part{};
+  std::uint32_t count = 0;
+
+  LeafPoints(const Eigen::Vector3d& centre, const Eigen::Vector3d& half, std::uint32_t n, const Eigen::Vector3d& tip = kTip)
+      : count(n) {
+    for (std::uint32_t i = 0; i < n; ++i) {
+      const double t = static_cast<double>(i);
+      const Eigen::Vector3d spread(std::sin(1.7 * t), std::cos(2.3 * t), std::sin(0.9 * t + 0.5));
+      const Eigen::Vector3d p = tip + centre + half.cwiseProduct(spread);
+      points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      const Eigen::Vector3d normal = Eigen::Vector3d(std::cos(t), std::sin(t), 0.5).normalized();
+      normals[i] = {static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z())};
+    }
+    part.points = points.data();
+    part.normals = normals.data();
+  }
+
+  [[nodiscard]] Eigen::Vector3d point(std::uint32_t i) const {
+    return {double{points[i].x_mm}, double{points[i].y_mm}, double{points[i].z_mm}};
+  }
+
+  // The meridian box holding every point, as the query computes it from the leaf's bounds.
+  [[nodiscard]] geometry::MeridianBox box() const {
+    Eigen::Vector3d low = point(0), high = point(0);
+    for (std::uint32_t i = 1; i < count; ++i) {
+      low = low.cwiseMin(point(i));
+      high = high.cwiseMax(point(i));
+    }
+    return geometry::upright_meridian_box(kTip, low, high);
+  }
+};
+
+// What the query does with a leaf of this cover.
+bool settle(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover, LeafContacts& leaf) {
+  switch (cover.cover) {
+    case geometry::BoxCover::Region:
+    case geometry::BoxCover::RegionOrOutside:
+      return region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
+    case geometry::BoxCover::SplitAtZ:
+      return split_leaf_contacts(tool, cover, leaf);
+    case geometry::BoxCover::Outside:
+    case geometry::BoxCover::Mixed:
+      break;
+  }
+  return mixed_leaf_contacts(tool, leaf);
+}
+
+// Every lane against the tool tree, point by point in double precision; returns how many
+// penetrate, so a case can insist that its leaf has some of each.
+std::uint32_t check_against_the_tree(const geometry::ToolBsp& tool, const LeafPoints& points, const LeafContacts& leaf) {
+  std::uint32_t penetrating = 0;
+  double deepest = 0.0;
+  std::uint32_t deepest_lane = 0;
+  for (std::uint32_t lane = 0; lane < points.count; ++lane) {
+    const geometry::PointClassification c = geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(lane));
+    const bool inside = c.contact != geometry::PointContact::Outside;
+    const bool deep = c.contact == geometry::PointContact::Penetrating;
+    CHECK(c.contact != geometry::PointContact::BadTree);
+    CHECK_EQUAL(inside, ((leaf.in_tool >> lane) & 1U) != 0);
+    CHECK_EQUAL(deep, ((leaf.penetrating_lanes >> lane) & 1U) != 0);
+    DOUBLES_EQUAL(deep ? c.depth_mm : 0.0, double{leaf.depth[lane]}, 1e-5);
+    if (inside) {
+      const Eigen::Vector3d escape(double{leaf.ex[lane]}, double{leaf.ey[lane]}, double{leaf.ez[lane]});
+      CHECK((escape - c.escape_direction).norm() < 1e-5);
+    }
+    if (deep) {
+      ++penetrating;
+      if (c.depth_mm > deepest) {
+        deepest = c.depth_mm;
+        deepest_lane = lane;
+      }
+    }
+  }
+  LONGS_EQUAL(penetrating, leaf.penetrating);
+  DOUBLES_EQUAL(deepest, leaf.max_depth_mm, 1e-12);  // settled in double precision
+  if (penetrating > 0) {
+    LONGS_EQUAL(deepest_lane, leaf.deepest_lane);
+  }
+  for (std::uint32_t lane = points.count; lane < tables::kMaxLeafPoints; ++lane) {
+    DOUBLES_EQUAL(0.0, double{leaf.depth[lane]}, 0.0);  // past the end: nothing, whatever it repeats
+  }
+  return penetrating;
+}
+
+// Over-aligned (its lanes): static storage, as the query keeps its own, not the test group's heap.
+LeafContacts the_leaf{};
+
+}  // namespace
+
+TEST_GROUP(LeafContacts) {
+  geometry::ToolBsp tool{};
+  LeafContacts& leaf = the_leaf;
+  void setup() override { CHECK(geometry::build_tool_bsp(kBall, tool).ok); }
+
+  void check_leaf(const LeafPoints& points, geometry::BoxCover expected_cover) {
+    const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+    CHECK(cover.cover == expected_cover);
+    load_leaf(points.part, 0, points.count, kTip, leaf);
+    CHECK(settle(tool, cover, leaf));
+    const std::uint32_t penetrating = check_against_the_tree(tool, points, leaf);
+    CHECK(penetrating > 0);
+  }
+};
+
+namespace {
+
+// Every lane's offset from `tip` to a float rounding of its own size, the lanes past the end
+// repeating the last point, and the leaf's magnitude the largest |x| + |y| + |z| of its lanes.
+void check_loaded(const LeafPoints& points, const Eigen::Vector3d& tip, const LeafContacts& leaf) {
+  LONGS_EQUAL(points.count, leaf.count);
+  POINTERS_EQUAL(points.points.data(), leaf.points);
+  float largest = 0.0F;
+  for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+    const Eigen::Vector3d offset = points.point(std::min(lane, points.count - 1)) - tip;
+    DOUBLES_EQUAL(offset.x(), double{leaf.x[lane]}, 1e-7);
+    DOUBLES_EQUAL(offset.y(), double{leaf.y[lane]}, 1e-7);
+    DOUBLES_EQUAL(offset.z(), double{leaf.z[lane]}, 1e-7);
+    DOUBLES_EQUAL(double{points.normals[std::min(lane, points.count - 1)].y_mm}, double{leaf.ny[lane]}, 0.0);
+    largest = std::max(largest, std::abs(leaf.x[lane]) + std::abs(leaf.y[lane]) + std::abs(leaf.z[lane]));
+  }
+  DOUBLES_EQUAL(double{largest}, double{leaf.magnitude_mm}, 0.0);
+}
+
+}  // namespace
+
+TEST(LeafContacts, TheLanesHoldEachPointsOffsetFromTheTipAndRepeatTheLastPastTheEnd) {
+  const LeafPoints points(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d(0.2, 0.2, 0.2), 5);
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  check_loaded(points, kTip, leaf);
+}
+
+// A tip that is not a float: its rest below a float's precision must reach the offsets. Written
+// as `tip - double(float(tip))`, GCC 12.2's SLP vectoriser folded the rest of x and y to 0 (the
+// object code had `vsubpd %xmm1,%xmm1,%xmm1`): off by up to half a float ulp of the tip (1.9e-6 mm
+// here; 7.6e-6 mm beyond 128 mm), where the comment promises a rounding of the offset's own size.
+TEST(LeafContacts, AnOffsetFromATipThatIsNotAFloatIsRightToARoundingOfItsOwnSize) {
+  const Eigen::Vector3d tip(123.456789, 78.9012345, 10.0625);
+  const LeafPoints points(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d(0.2, 0.2, 0.2), 5, tip);
+  load_leaf(points.part, 0, points.count, tip, leaf);
+  check_loaded(points, tip, leaf);
+}
+
+TEST(LeafContacts, ALeafInsideTheBallIsSettledByItsSurfaceAsTheTreeWouldSettleEachPoint) {
+  check_leaf(LeafPoints(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), 32),
+             geometry::BoxCover::Region);
+  LONGS_EQUAL(32, leaf.penetrating);
+}
+
+TEST(LeafContacts, ALeafAcrossTheBallsSurfaceHasThePointsOutsideLeftOut) {
+  check_leaf(LeafPoints(Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d(0.05, 0.05, 0.02), 20),
+             geometry::BoxCover::RegionOrOutside);
+  CHECK(leaf.penetrating < 20);  // some are below the tip: outside
+}
+
+TEST(LeafContacts, ALeafAcrossThePlaneBetweenBallAndFlutesTakesEachSidesSurface) {
+  check_leaf(LeafPoints(Eigen::Vector3d(1.3, 0.0, 1.5), Eigen::Vector3d(0.05, 0.05, 0.1), 24),
+             geometry::BoxCover::SplitAtZ);
+}
+
+TEST(LeafContacts, ALeafAcrossSeveralOfTheTreesTestsIsSettledPointByPoint) {
+  const LeafPoints points(Eigen::Vector3d(0.8, 0.0, 1.2), Eigen::Vector3d(1.0, 1.0, 1.0), 32);
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK(mixed_leaf_contacts(tool, leaf));
+  const std::uint32_t penetrating = check_against_the_tree(tool, points, leaf);
+  CHECK(penetrating > 0);
+  CHECK(penetrating < 32);
+}
+
+TEST(LeafContacts, TheDeepestOfPointsTheFloatsCannotTellApartIsFoundInDoublePrecision) {
+  // Two points inside the ball whose lane depths are the same float but whose depths are not.
+  LeafPoints pair(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), 2);
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(
+      tool, geometry::upright_meridian_box(kTip, kTip + Eigen::Vector3d(0.1, 0.0, 0.5), kTip + Eigen::Vector3d(0.4, 0.3, 0.8)));
+  CHECK(cover.cover == geometry::BoxCover::Region);
+  // Candidates by their lane depth: the first two with one float depth and two double ones.
+  std::map<float, std::pair<tables::PackedPoint, double>> seen;
+  bool found = false;
+  tables::PackedPoint first{}, second{};
+  for (int i = 0; i < 20000 && !found; ++i) {
+    const double t = static_cast<double>(i);
+    const Eigen::Vector3d p = kTip + Eigen::Vector3d(0.25 + 0.15 * std::sin(1.3 * t), 0.15 + 0.15 * std::cos(0.7 * t),
+                                                     0.65 + 0.15 * std::sin(2.9 * t));
+    pair.points[0] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    load_leaf(pair.part, 0, 1, kTip, leaf);
+    CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+    const auto [at, added] = seen.emplace(leaf.depth[0], std::make_pair(pair.points[0], leaf.max_depth_mm));
+    if (!added && at->second.second < leaf.max_depth_mm) {
+      first = at->second.first;  // the shallower first
+      second = pair.points[0];
+      found = true;
+    }
+  }
+  CHECK_TEXT(found, "no two points with the same float depth among the candidates");
+  pair.points[0] = first;
+  pair.points[1] = second;
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  DOUBLES_EQUAL(double{leaf.depth[0]}, double{leaf.depth[1]}, 0.0);
+  check_against_the_tree(tool, pair, leaf);  // the deepest lane and depth: the double-precision ones
+  std::swap(pair.points[0], pair.points[1]);
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  check_against_the_tree(tool, pair, leaf);
+  // A true tie: the first lane at the deepest depth.
+  pair.points[1] = pair.points[0];
+  load_leaf(pair.part, 0, 2, kTip, leaf);
+  CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
+  LONGS_EQUAL(0, leaf.deepest_lane);
+}
+
+TEST(LeafContacts, ADamagedToolTreeIsAFaultNotANumber) {
+  const LeafPoints points(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), 8);
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::Region);
+  geometry::ToolBsp damaged = tool;
+  damaged.surfaces[damaged.regions[cover.region].surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK_FALSE(region_leaf_contacts(damaged, cover.region, false, leaf));
+  geometry::ToolBsp broken = tool;
+  broken.node_count = 0;  // no root: every walk is a bad tree
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK_FALSE(mixed_leaf_contacts(broken, leaf));
+}
+
+TEST(LeafContacts, TheForceSumsAreEachPenetratingPointsDepthAlongItsNormalLessItsEscape) {
+  const LeafPoints points(Eigen::Vector3d(0.8, 0.0, 1.2), Eigen::Vector3d(1.0, 1.0, 1.0), 32);
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK(mixed_leaf_contacts(tool, leaf));
+  const double k = 10.0;
+  const double height = 7.5;
+  // The same sum in double precision from the tree's own answers.
+  Eigen::Vector3d force = Eigen::Vector3d::Zero(), torque = Eigen::Vector3d::Zero();
+  for (std::uint32_t i = 0; i < points.count; ++i) {
+    const geometry::PointClassification c = geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(i));
+    if (c.contact != geometry::PointContact::Penetrating) {
+      continue;
+    }
+    const Eigen::Vector3d normal(double{points.normals[i].x_mm}, double{points.normals[i].y_mm},
+                                 double{points.normals[i].z_mm});
+    const Eigen::Vector3d f = k * c.depth_mm * (normal - c.escape_direction).normalized();
+    force += f;
+    torque += (points.point(i) - kTip - Eigen::Vector3d(0.0, 0.0, height)).cross(f);
+  }
+  CHECK(force.norm() > 1.0);
+  const LeafForceSums sums = leaf_forces(leaf, k, height);
+  CHECK((sums.force - force).norm() < 1e-4 * force.norm());
+  CHECK((sums.torque - torque).norm() < 1e-4 * torque.norm() + 1e-6);
+}
+
+TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
+  LeafPoints points(Eigen::Vector3d(0.0, 0.0, 0.5), Eigen::Vector3d(0.0, 0.0, 0.0), 1);  // on the axis, 1 mm in
+  // Straight below the ball's centre the escape is straight down: a normal pointing down cancels it.
+  points.normals[0] = {0.0F, 0.0F, -1.0F};
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK(mixed_leaf_contacts(tool, leaf));
+  LONGS_EQUAL(1, leaf.penetrating);
+  const LeafForceSums none = leaf_forces(leaf, 10.0, 7.5);
+  CHECK(none.force == Eigen::Vector3d::Zero());
+  CHECK(none.torque == Eigen::Vector3d::Zero());
+  // Turned up, it pushes the tool up with k times the depth.
+  points.normals[0] = {0.0F, 0.0F, 1.0F};
+  load_leaf(points.part, 0, points.count, kTip, leaf);
+  CHECK(mixed_leaf_contacts(tool, leaf));
+  const LeafForceSums up = leaf_forces(leaf, 10.0, 7.5);
+  DOUBLES_EQUAL(10.0 * leaf.max_depth_mm, up.force.z(), 1e-5);
+  DOUBLES_EQUAL(0.0, up.force.head<2>().norm(), 1e-7);
+}
