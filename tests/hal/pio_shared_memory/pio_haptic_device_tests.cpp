@@ -1,5 +1,5 @@
 // The PIO shared memory backend's own behaviour, beyond the HapticDevice contract that
-// tests/hal/haptic_device_contract_tests.cpp runs on every backend (fresh, stale, lost, range,
+// tests/hal/haptic_device_tests.cpp runs on every backend (fresh, stale, lost, range,
 // clamping, torn samples): a writer stuck mid-write, the device's own limits, the host heartbeat
 // carried across a host restart, arming the device's host watchdog (a restarted host, a trip during
 // the run), seqlock reads racing a real writer thread, and the time of one cycle.

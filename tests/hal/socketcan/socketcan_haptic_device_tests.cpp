@@ -1,5 +1,5 @@
 // The SocketCAN backend's own behaviour, beyond the HapticDevice contract that
-// tests/hal/haptic_device_contract_tests.cpp runs on every backend (fresh, stale, lost, range,
+// tests/hal/haptic_device_tests.cpp runs on every backend (fresh, stale, lost, range,
 // clamping, torn poses): the 8-bit wire counter extended, every kind of bad frame, error frames
 // (bus-off, overflow, recovery), a backlog at the first read, torque quantisation, a full or closed
 // socket, no channel, the time of one cycle, all end to end through a SOCK_SEQPACKET socket pair

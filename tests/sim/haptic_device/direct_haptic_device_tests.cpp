@@ -1,5 +1,5 @@
 // DirectHapticDevice (sim/haptic_device/direct_haptic_device.hpp) for what is its own beyond the
-// HapticDevice contract (tests/hal/haptic_device_contract_tests.cpp runs that on it): a published pose
+// HapticDevice contract (tests/hal/haptic_device_tests.cpp runs that on it): a published pose
 // rounded to whole micrometres and microradians as the PIO words carry it, values no wire could carry
 // left for the range checks, and the command it renders (zero before the first write, with enable off
 // and for a non-finite command; clamped; the cycle counter echoed).
