@@ -19,13 +19,14 @@ void PioDeviceSide::publish_pose(const PoseWords& pose) {
 }
 
 bool command_within_device_limits(const CommandWords& command) {
-  // Squares in 64 bits: 2^31 squared three times does not overflow.
-  std::int64_t force_squared = 0;
-  for (const std::int32_t force : command.force_mn) force_squared += std::int64_t{force} * force;
-  std::int64_t torque_squared = 0;
-  for (const std::int32_t torque : command.torque_mnmm) torque_squared += std::int64_t{torque} * torque;
-  return force_squared <= std::int64_t{kForceLimitMn} * kForceLimitMn &&
-         torque_squared <= std::int64_t{kTorqueLimitMnmm} * kTorqueLimitMnmm &&
+  // Each square is at most 2^62 (of -2^31) and fits a signed 64 bits, but two of them do not: the
+  // sums are unsigned, where three of 2^62 fit.
+  const auto square = [](std::int32_t word) { return static_cast<std::uint64_t>(std::int64_t{word} * word); };
+  std::uint64_t force_squared = 0;
+  for (const std::int32_t force : command.force_mn) force_squared += square(force);
+  std::uint64_t torque_squared = 0;
+  for (const std::int32_t torque : command.torque_mnmm) torque_squared += square(torque);
+  return force_squared <= square(kForceLimitMn) && torque_squared <= square(kTorqueLimitMnmm) &&
          (command.flags & ~kCommandEnableBit) == 0U;
 }
 

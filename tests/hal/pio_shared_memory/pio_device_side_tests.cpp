@@ -111,14 +111,10 @@ TEST(PioDeviceSide, TheDevicesOwnLimitsAreInclusiveMagnitudes) {
   CHECK_FALSE(pio::command_within_device_limits(command_words(0, std::numeric_limits<std::int32_t>::max(), 0, 1)));
 }
 
-// KNOWN BUG, left for its owner (not fixed here, as the brief says): pio_device_side.cpp sums the
-// squares in int64_t and its comment says "2^31 squared three times does not overflow", but 2^62 * 2
-// is already 2^63: two or three words near the int32 limits overflow the sum (undefined behaviour; in
-// practice it wraps negative) and the command is ACCEPTED as within the 5 N / 200 N.mm limits. The
-// host clamps before it writes, so only a broken or hostile host can send such words; the device's
-// own check exists for exactly that host. Remove IGNORE_ once the sum cannot overflow (e.g. compare
-// each |word| with the limit first, or sum in unsigned / long double).
-IGNORE_TEST(PioDeviceSide, TheSquaresOfTheLargestWordsDoNotWrapRoundToSomethingSmall) {
+// Words near the int32 limits: their squares summed in a signed 64 bits overflowed (2^62 twice is
+// 2^63; undefined, in practice negative) and such a command was accepted as within 5 N. The host
+// clamps before it writes, so only a broken host sends them: the device's own check is for it.
+TEST(PioDeviceSide, TheSquaresOfTheLargestWordsDoNotWrapRoundToSomethingSmall) {
   constexpr std::int32_t kMost = std::numeric_limits<std::int32_t>::max();
   constexpr std::int32_t kLeast = std::numeric_limits<std::int32_t>::min();
   CHECK_FALSE(pio::command_within_device_limits(command_words(kLeast, kLeast, kMost, 1)));
