@@ -1,9 +1,12 @@
 // The machinist at stencil-rig's terminal during commissioning (firmware/programs/terminal_machinist):
 // a dial indicator's reading typed as a number and Enter (trailing spaces and a CR allowed), anything
 // else asked again, the end of input or an interrupt ending the wait, and the idle callback (the
-// watchdog relay's heartbeat) called while waiting. Standard input is a pipe here, and the questions
-// on standard output go to /dev/null; both are put back after each test.
+// watchdog relay's heartbeat) called while waiting. Standard input is a pipe here, and standard output
+// (the questions) a file, shown after a test only when it failed (CppUTest's own report of the
+// failure goes there too); both are put back after each test.
 #include <atomic>
+#include <cstdio>
+#include <cstdlib>
 #include <string>
 
 #include <fcntl.h>
@@ -20,6 +23,7 @@ using app::TerminalMachinist;
 TEST_GROUP(TerminalMachinist) {
   int saved_stdin = -1;
   int saved_stdout = -1;
+  int captured = -1;
   int writer = -1;
   int idles = 0;
   std::function<void()> idle = [this] { ++idles; };
@@ -33,9 +37,10 @@ TEST_GROUP(TerminalMachinist) {
     writer = ends[1];
     std::fflush(stdout);
     saved_stdout = dup(STDOUT_FILENO);
-    const int null = open("/dev/null", O_WRONLY);
-    dup2(null, STDOUT_FILENO);
-    close(null);
+    char name[] = "/tmp/terminal_machinist_tests_XXXXXX";
+    captured = mkstemp(name);
+    unlink(name);
+    dup2(captured, STDOUT_FILENO);
   }
   void teardown() override {
     if (writer >= 0) {
@@ -46,6 +51,14 @@ TEST_GROUP(TerminalMachinist) {
     std::fflush(stdout);
     dup2(saved_stdout, STDOUT_FILENO);
     close(saved_stdout);
+    if (UtestShell::getCurrent()->hasFailed()) {
+      char text[4096];
+      lseek(captured, 0, SEEK_SET);
+      for (ssize_t n = read(captured, text, sizeof text); n > 0; n = read(captured, text, sizeof text)) {
+        std::fwrite(text, 1, static_cast<std::size_t>(n), stdout);
+      }
+    }
+    close(captured);
   }
   void type(const std::string& text) const { CHECK_EQUAL(static_cast<ssize_t>(text.size()), write(writer, text.data(), text.size())); }
   void close_input() {
