@@ -1,7 +1,7 @@
 // The comparisons stencil-same-behaviour makes: two journals of the same job are the same apart from
 // their start times and their Provenance records (which build, which command line), whichever side
 // has them (version 3 against version 4); a real difference after a Provenance record is still found
-// and placed. Two reports are the same apart from the wall clock and their provenance.
+// and placed. (The reports' comparison: report_comparison_tests.cpp.)
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -9,11 +9,8 @@
 
 #include <unistd.h>
 
-#include <nlohmann/json.hpp>
-
 #include "firmware/services/journal/journal_writer.hpp"
 #include "toolchain/same_behaviour/journal_comparison.hpp"
-#include "toolchain/same_behaviour/report_comparison.hpp"
 #include "tests/support/old_journal.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -76,9 +73,9 @@ void write_old_job(const std::string& path, std::uint32_t version, const std::st
 
 }  // namespace
 
-TEST_GROUP(SameBehaviour){};
+TEST_GROUP(JournalComparison){};
 
-TEST(SameBehaviour, JournalsOfTheSameJobAreTheSameWhateverBuildAndStartWroteThem) {
+TEST(JournalComparison, JournalsOfTheSameJobAreTheSameWhateverBuildAndStartWroteThem) {
   TempFile older, newer;
   write_job(older.path, "stencil-sim abc123 (GNU 12); command: /old/build/bin/stencil-sim --fast", 1'000);
   write_job(newer.path, "stencil-sim def456-dirty (GNU 12); command: /new/build/bin/stencil-sim --fast --report r.json", 2'000);
@@ -90,7 +87,7 @@ TEST(SameBehaviour, JournalsOfTheSameJobAreTheSameWhateverBuildAndStartWroteThem
   CHECK_EQUAL(3U, result.records);  // start, one Cycles record of 4 cycles, end: the provenance left out
 }
 
-TEST(SameBehaviour, ADifferentToolInACompactJournalIsFoundInItsCyclesRecord) {
+TEST(JournalComparison, ADifferentToolInACompactJournalIsFoundInItsCyclesRecord) {
   TempFile older, newer;
   write_job(older.path, "a", 1'000);
   write_job(newer.path, "b", 2'000, 25.001);
@@ -101,7 +98,7 @@ TEST(SameBehaviour, ADifferentToolInACompactJournalIsFoundInItsCyclesRecord) {
   STRCMP_CONTAINS("its payload from byte", result.differences[0].c_str());
 }
 
-TEST(SameBehaviour, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One) {
+TEST(JournalComparison, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One) {
   TempFile older, newer;
   write_old_job(older.path, 3, "", 1'000);
   write_old_job(newer.path, 4, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000);
@@ -111,7 +108,7 @@ TEST(SameBehaviour, AVersion3JournalWithoutProvenanceIsTheSameJobAsAVersion4One)
   CHECK_EQUAL(1U, result.provenance);
 }
 
-TEST(SameBehaviour, ADifferenceAfterAProvenanceRecordIsFoundAndPlaced) {
+TEST(JournalComparison, ADifferenceAfterAProvenanceRecordIsFoundAndPlaced) {
   TempFile older, newer;
   write_old_job(older.path, 3, "", 1'000);
   write_old_job(newer.path, 4, "stencil-sim def456 (GNU 12); command: stencil-sim --fast", 2'000, 25.001);
@@ -126,18 +123,4 @@ TEST(SameBehaviour, ADifferenceAfterAProvenanceRecordIsFoundAndPlaced) {
   const same_behaviour::JournalComparison versions = same_behaviour::compare_journals(older.path, newer.path);
   CHECK(versions.differences.size() >= 1U);
   STRCMP_CONTAINS("the file versions differ: 4 and 5", versions.differences[0].c_str());
-}
-
-TEST(SameBehaviour, ReportsLeaveOutTheWallClockAndTheProvenanceButNothingElse) {
-  const nlohmann::json older = {{"cycles", 100}, {"wall_s", 3.5},
-                                {"provenance", {{"version", "abc"}, {"command_line", {"/old/stencil-sim"}}}}};
-  nlohmann::json newer = {{"cycles", 100}, {"wall_s", 4.0},
-                          {"provenance", {{"version", "def"}, {"command_line", {"/new/stencil-sim", "--fast"}}}}};
-  same_behaviour::ReportComparison result = same_behaviour::compare_reports(older, newer);
-  CHECK_EQUAL(0U, result.changed.size());
-  CHECK_EQUAL(0U, result.added.size());
-  newer["cycles"] = 101;
-  result = same_behaviour::compare_reports(older, newer);
-  CHECK_EQUAL(1U, result.changed.size());
-  STRCMP_CONTAINS("cycles", result.changed[0].c_str());
 }

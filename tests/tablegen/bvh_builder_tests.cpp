@@ -1,0 +1,132 @@
+// The points' 14-DOP tree (toolchain/tablegen/bvh_builder): every point in exactly one leaf, every
+// leaf full but the last, every node's DOP holding everything below it, the left child right after
+// its parent and the right child where the node counts say; the same tree whatever the threads.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "firmware/core/geometry/kdop14.hpp"
+#include "firmware/core/tables/table_format.hpp"
+#include "toolchain/tablegen/bvh_builder.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::tablegen;
+
+namespace {
+
+// `count` points on a lopsided spiral: no two share a coordinate, and every slab has extent.
+std::vector<tables::PackedPoint> spiral(std::uint32_t count) {
+  std::vector<tables::PackedPoint> points;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    const double t = 0.37 * i;
+    points.push_back({static_cast<float>(25.0 + 0.02 * i * std::cos(t)), static_cast<float>(12.0 + 0.01 * i * std::sin(t)),
+                      static_cast<float>(0.003 * i)});
+  }
+  return points;
+}
+
+// Walks the subtree at `index`: each point's leaves counted, each leaf's size in depth-first order.
+std::uint32_t check_subtree(const PointTree& tree, std::uint32_t index,
+                            std::vector<int>& seen, std::vector<std::uint32_t>& leaf_sizes) {
+  const tables::BvhNode& node = tree.nodes[index];
+  std::uint32_t below = 0;
+  if (node.point_count > 0) {
+    leaf_sizes.push_back(node.point_count);
+    for (std::uint32_t slot = node.first_point; slot < node.first_point + node.point_count; ++slot) {
+      ++seen[tree.order[slot]];
+    }
+    below = node.point_count;
+  } else {
+    CHECK(node.right_child > index + 1);
+    below = check_subtree(tree, index + 1, seen, leaf_sizes) +
+            check_subtree(tree, node.right_child, seen, leaf_sizes);
+  }
+  return below;
+}
+
+// The point inside the node's DOP, by the table's own slab directions.
+bool dop_holds(const tables::BvhNode& node, const tables::PackedPoint& p) {
+  for (std::size_t slab = 0; slab < geometry::kKdopSlabCount; ++slab) {
+    const auto& d = geometry::kKdopSlabDirections[slab];
+    const double projection = d[0] * double{p.x_mm} + d[1] * double{p.y_mm} + d[2] * double{p.z_mm};
+    if (projection < node.dop_min[slab] - 1e-9 || projection > node.dop_max[slab] + 1e-9) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+TEST_GROUP(BvhBuilder){};
+
+TEST(BvhBuilder, TheLeftChildTakesHalfItsLeavesWorth) {
+  CHECK_EQUAL(32U, point_tree_left_count(33));
+  CHECK_EQUAL(32U, point_tree_left_count(64));
+  CHECK_EQUAL(32U, point_tree_left_count(96));  // three leaves: one left, two right
+  CHECK_EQUAL(64U, point_tree_left_count(97));  // four leaves: two and two
+}
+
+TEST(BvhBuilder, NodeCountsFollowTheSplit) {
+  CHECK_EQUAL(1U, point_tree_node_count(1));
+  CHECK_EQUAL(1U, point_tree_node_count(32));
+  CHECK_EQUAL(3U, point_tree_node_count(33));
+  CHECK_EQUAL(5U, point_tree_node_count(96));
+  CHECK_EQUAL(7U, point_tree_node_count(128));
+}
+
+TEST(BvhBuilder, EveryPointIsInOneFullLeafAndInsideEveryDopAboveIt) {
+  const std::vector<tables::PackedPoint> points = spiral(1000);
+  const PointTree tree = build_point_tree(points, 1);
+  CHECK_EQUAL(point_tree_node_count(points.size()), tree.nodes.size());
+  CHECK_EQUAL(points.size(), tree.order.size());
+  std::vector<int> seen(points.size(), 0);
+  std::vector<std::uint32_t> leaf_sizes;
+  CHECK_EQUAL(1000U, check_subtree(tree, 0, seen, leaf_sizes));
+  CHECK(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
+  // Leaves in depth-first order: all full but the last (1000 = 31 * 32 + 8).
+  CHECK_EQUAL(32U, leaf_sizes.size());
+  for (std::size_t i = 0; i + 1 < leaf_sizes.size(); ++i) {
+    CHECK_EQUAL(tables::kMaxLeafPoints, leaf_sizes[i]);
+  }
+  CHECK_EQUAL(8U, leaf_sizes.back());
+  // The root's DOP holds every point; each leaf's DOP holds its own.
+  for (const tables::PackedPoint& p : points) {
+    CHECK(dop_holds(tree.nodes[0], p));
+  }
+  for (const tables::BvhNode& node : tree.nodes) {
+    for (std::uint32_t slot = node.first_point; slot < node.first_point + node.point_count; ++slot) {
+      CHECK(dop_holds(node, points[tree.order[slot]]));
+    }
+  }
+}
+
+TEST(BvhBuilder, TheLowerHalfAlongTheWidestSlabGoesLeft) {
+  // 64 points along x only: the root splits them at x's median, the lower 32 to the left.
+  std::vector<tables::PackedPoint> points;
+  for (int i = 63; i >= 0; --i) {
+    points.push_back({static_cast<float>(i), 0.0f, 0.0f});
+  }
+  const PointTree tree = build_point_tree(points, 1);
+  CHECK_EQUAL(3U, tree.nodes.size());
+  const tables::BvhNode& left = tree.nodes[1];
+  for (std::uint32_t slot = left.first_point; slot < left.first_point + left.point_count; ++slot) {
+    CHECK(points[tree.order[slot]].x_mm < 32.0f);
+  }
+}
+
+TEST(BvhBuilder, TheTreeIsTheSameWhateverTheThreads) {
+  const std::vector<tables::PackedPoint> points = spiral(5000);
+  const PointTree one = build_point_tree(points, 1);
+  const PointTree two = build_point_tree(points, 2);
+  CHECK(one.order == two.order);
+  CHECK_EQUAL(one.nodes.size(), two.nodes.size());
+  CHECK_EQUAL(0, std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(tables::BvhNode)));
+}
