@@ -15,7 +15,7 @@
 # mutation was caught, 1 when one survived, 2 when the set-up failed.
 set -uo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-work=${1:-$root/build/mutation}
+work=$(realpath -m "${1:-$root/build/mutation}")
 table=$root/tests/mutations.tsv
 src=$work/src
 build=$src/build  # inside the copy, as in the tree: ccache (used when installed) then hits across copies
