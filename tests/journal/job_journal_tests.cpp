@@ -6,17 +6,15 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
+#include <filesystem>
 #include <string>
 #include <vector>
-
-#include <dirent.h>
-#include <unistd.h>
 
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
 #include "tests/support/journal_fixtures.hpp"
+#include "tests/support/temp_folder.hpp"
 
 #include <CppUTest/TestHarness.h>
 
@@ -25,37 +23,14 @@ using namespace stencil::testing;
 
 namespace {
 
-// A folder of its own under /tmp, emptied and removed with the object.
-struct TempFolder {
-  std::string path;
-  TempFolder() {
-    char name[] = "/tmp/job_journal_tests_XXXXXX";
-    path = mkdtemp(name) != nullptr ? name : "";
+// The files in `folder`, by name.
+std::vector<std::string> files_in(const TempFolder& folder) {
+  std::vector<std::string> names;
+  for (const auto& entry : std::filesystem::directory_iterator(folder.dir)) {
+    names.push_back(entry.path().filename().string());
   }
-  ~TempFolder() {
-    for (const std::string& file : files()) {
-      std::remove((path + "/" + file).c_str());
-    }
-    ::rmdir(path.c_str());
-  }
-  TempFolder(const TempFolder&) = delete;
-  TempFolder& operator=(const TempFolder&) = delete;
-  [[nodiscard]] std::vector<std::string> files() const {
-    std::vector<std::string> names;
-    DIR* dir = ::opendir(path.c_str());
-    if (dir == nullptr) {
-      return names;
-    }
-    while (const dirent* entry = ::readdir(dir)) {
-      const std::string name = entry->d_name;
-      if (name != "." && name != "..") {
-        names.push_back(name);
-      }
-    }
-    ::closedir(dir);
-    return names;
-  }
-};
+  return names;
+}
 
 std::int64_t now_ns() {
   return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count();
@@ -75,9 +50,9 @@ JobJournalRequest request_for(const std::string& program) {
 TEST_GROUP(JobJournal){};
 
 TEST(JobJournal, AFreshJournalIsNamedAfterItsProgramAndStartTimeInItsFolderAndItsStartSaysSo) {
-  TempFolder folder;
+  TempFolder folder("job_journal_tests");
   JobJournalRequest request = request_for("stencil-sim");
-  request.folder = folder.path;
+  request.folder = folder.path();
   JournalWriter writer;
   std::string opened;
   std::string error;
@@ -87,12 +62,12 @@ TEST(JobJournal, AFreshJournalIsNamedAfterItsProgramAndStartTimeInItsFolderAndIt
   CHECK_TRUE(writer.is_open());
   CHECK_TRUE(writer.close());
   // stencil-sim-YYYYMMDD-HHMMSS.journal
-  const std::string prefix = folder.path + "/stencil-sim-";
+  const std::string prefix = folder.path() + "/stencil-sim-";
   STRCMP_EQUAL(prefix.c_str(), opened.substr(0, prefix.size()).c_str());
   LONGS_EQUAL(prefix.size() + 8 + 1 + 6 + 8, opened.size());
   CHECK_EQUAL('-', opened[prefix.size() + 8]);
   STRCMP_EQUAL(".journal", opened.substr(opened.size() - 8).c_str());
-  LONGS_EQUAL(1, folder.files().size());
+  LONGS_EQUAL(1, files_in(folder).size());
   Seen seen;
   const JournalReadResult read = read_journal_file(opened, seen.visitor());
   CHECK_TEXT(read.ok, read.error.c_str());
@@ -106,10 +81,10 @@ TEST(JobJournal, AFreshJournalIsNamedAfterItsProgramAndStartTimeInItsFolderAndIt
 }
 
 TEST(JobJournal, APathAskedForIsTheOneWrittenAndNoJournalOpensNothing) {
-  TempFolder folder;
+  TempFolder folder("job_journal_tests");
   JobJournalRequest request = request_for("stencil-rig");
   request.folder = "/nonexistent";  // only the default name's
-  request.path = folder.path + "/mine.journal";
+  request.path = folder.path() + "/mine.journal";
   JournalWriter writer;
   std::string opened = "stale";
   std::string error;
@@ -120,13 +95,13 @@ TEST(JobJournal, APathAskedForIsTheOneWrittenAndNoJournalOpensNothing) {
 
   JobJournalRequest none = request_for("stencil-rig");
   none.none = true;
-  none.folder = folder.path;
+  none.folder = folder.path();
   JournalWriter unopened;
   opened = "stale";
   CHECK_TRUE(open_job_journal(none, unopened, opened, error));
   CHECK_TRUE(opened.empty());
   CHECK_FALSE(unopened.is_open());
-  LONGS_EQUAL(1, folder.files().size());  // mine.journal only
+  LONGS_EQUAL(1, files_in(folder).size());  // mine.journal only
 }
 
 TEST(JobJournal, AJournalThatCannotBeCreatedIsAnErrorNamingItAndNoPath) {
@@ -183,17 +158,17 @@ TEST(JobJournal, AResumedJournalCarriesOnInTheJobsOwnFileWhateverElseWasAsked) {
 }
 
 TEST(JobJournal, AFreshRunThatNeverRanLeavesNoFile) {
-  TempFolder folder;
+  TempFolder folder("job_journal_tests");
   JobJournalRequest request = request_for("stencil-sim");
-  request.folder = folder.path;
+  request.folder = folder.path();
   JournalWriter writer;
   std::string opened;
   std::string error;
   CHECK_TEXT(open_job_journal(request, writer, opened, error), error.c_str());
-  LONGS_EQUAL(1, folder.files().size());
+  LONGS_EQUAL(1, files_in(folder).size());
   CHECK_TRUE(undo_unrun_job_journal(request, writer, opened));
   CHECK_FALSE(writer.is_open());
-  LONGS_EQUAL(0, folder.files().size());
+  LONGS_EQUAL(0, files_in(folder).size());
   // Nothing opened (--no-journal): nothing to undo.
   JobJournalRequest none = request;
   none.none = true;
