@@ -1,15 +1,11 @@
-// The operator display's own rules and state (stencil-display): its endpoint and token rules, the
-// request parser and the limits it checks, and the live state built from a controller's feed
-// (through a real DisplayLink): deltas and snapshots, the stock, the reset rule, the job's end; and
-// the display's handling of a browser's requests before they go to the controller.
-#include <sys/stat.h>
+// The display's live state (hmi_live_state.hpp), built from a controller's feed through a real
+// DisplayLink: the touched set mirrored and sent as deltas then whole, the stock as cells and a
+// grid, the largest force since the last frame, what it says with no controller and at the job's
+// end, and reset and pause refused when there is nothing to reset or pause.
 #include <unistd.h>
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -19,11 +15,9 @@
 #include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/core/tables/table_loader.hpp"
 #include "firmware/services/display_link/display_link.hpp"
-#include "firmware/services/hmi/display_app.hpp"
-#include "firmware/services/hmi/hmi_access.hpp"
 #include "firmware/services/hmi/hmi_live_state.hpp"
-#include "firmware/services/hmi/hmi_requests.hpp"
 #include "tests/support/sample_tables.hpp"
+#include "tests/support/temp_folder.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>
@@ -48,16 +42,6 @@ control::ControllerConfig config() {
   return c;
 }
 
-struct Folder {
-  std::filesystem::path dir;
-  Folder() {
-    char pattern[] = "/tmp/hmi-tests-XXXXXX";
-    dir = mkdtemp(pattern);
-  }
-  ~Folder() { std::filesystem::remove_all(dir); }
-  [[nodiscard]] std::string socket() const { return (dir / "display.sock").string(); }
-};
-
 control::JournalRecord record_at(std::uint64_t cycle, const Eigen::Vector3d& tip, std::uint32_t touched) {
   control::JournalRecord r{};
   r.cycle = cycle;
@@ -73,12 +57,12 @@ control::JournalRecord record_at(std::uint64_t cycle, const Eigen::Vector3d& tip
 // A controller's link and a display's view of its feed, in one process: what the boards feed the
 // link is what the live state reads (published at once: end() publishes without the rate limit).
 struct Linked {
-  Folder folder;
+  testing::TempFolder folder{"hmi-tests"};
   display_link::DisplayLink link;
   display_link::FeedView view;
   LiveState state;
   Linked(const tables::PartTables& part, const control::ControllerConfig& c)
-      : link(part, c, {folder.socket(), "stencil-test", false}) {
+      : link(part, c, {folder.file("display.sock"), "stencil-test", false}) {
     std::string error;
     CHECK_TRUE_TEXT(link.start(error), error.c_str());
     CHECK_TRUE_TEXT(view.open(dup(link.feed_fd()), error), error.c_str());
@@ -90,123 +74,6 @@ struct Linked {
 };
 
 }  // namespace
-
-TEST_GROUP(HmiAccess){};
-
-TEST(HmiAccess, EndpointsAreParsedAndBadOnesNamed) {
-  HmiEndpoint e;
-  std::string error;
-  CHECK(parse_endpoint("", e, error));
-  STRCMP_EQUAL("127.0.0.1", e.host.c_str());
-  CHECK_EQUAL(8080, e.port);
-  CHECK(parse_endpoint("0.0.0.0:9000", e, error));
-  STRCMP_EQUAL("0.0.0.0", e.host.c_str());
-  CHECK_EQUAL(9000, e.port);
-  CHECK(parse_endpoint("[::1]:81", e, error));
-  STRCMP_EQUAL("::1", e.host.c_str());
-  CHECK(parse_endpoint("localhost:0", e, error));
-  STRCMP_EQUAL("127.0.0.1", e.host.c_str());
-  CHECK_FALSE(parse_endpoint("127.0.0.1", e, error));
-  CHECK(error.find("HOST:PORT") != std::string::npos);
-  CHECK_FALSE(parse_endpoint("127.0.0.1:70000", e, error));
-  CHECK(error.find("0 to 65535") != std::string::npos);
-  CHECK_FALSE(parse_endpoint("127.0.0.1:80x", e, error));
-  CHECK_FALSE(parse_endpoint("example.com:80", e, error));
-  CHECK(error.find("numeric") != std::string::npos);
-  CHECK_FALSE(parse_endpoint("[::1:80", e, error));
-}
-
-TEST(HmiAccess, BeyondLoopbackATokenIsNeededAndOnlyItsHolderMayControl) {
-  std::string error;
-  CHECK(check_access({"127.0.0.1", 8080}, "", error));
-  CHECK(check_access({"::1", 8080}, "", error));
-  CHECK_FALSE(check_access({"0.0.0.0", 8080}, "", error));
-  CHECK(error.find("needs a token, from a file only its owner reads") != std::string::npos);
-  CHECK_FALSE(check_access({"192.168.1.5", 8080}, "", error));
-  CHECK(check_access({"0.0.0.0", 8080}, "s3cret-token", error));
-  CHECK_FALSE(check_access({"0.0.0.0", 8080}, "short", error));
-  CHECK_FALSE(check_access({"0.0.0.0", 8080}, "has space in it", error));
-  CHECK(is_loopback("127.3.4.5"));
-  CHECK_FALSE(is_loopback("128.0.0.1"));
-  CHECK_FALSE(is_loopback("::2"));
-
-  CHECK(may_control("", ""));  // loopback, no token set: the operator at the machine
-  CHECK(may_control("s3cret-token", "s3cret-token"));
-  CHECK_FALSE(may_control("s3cret-token", ""));
-  CHECK_FALSE(may_control("s3cret-token", "s3cret-toke"));
-  CHECK_FALSE(may_control("s3cret-token", "s3cret-tokenX"));
-  CHECK_FALSE(may_control("s3cret-token", "S3cret-token"));
-}
-
-TEST(HmiAccess, OnlyThisServersOwnPageMayOpenTheSocket) {
-  CHECK(same_origin("http://127.0.0.1:8080", "127.0.0.1:8080"));
-  CHECK(same_origin("https://rig:8443", "rig:8443"));
-  CHECK_FALSE(same_origin("http://evil.example", "127.0.0.1:8080"));
-  CHECK_FALSE(same_origin("http://127.0.0.1:8081", "127.0.0.1:8080"));
-  CHECK_FALSE(same_origin("http://127.0.0.1:8080.evil", "127.0.0.1:8080"));
-  CHECK_FALSE(same_origin("null", "127.0.0.1:8080"));
-  CHECK_FALSE(same_origin("http://127.0.0.1:8080", ""));
-}
-
-TEST_GROUP(HmiRequests){};
-
-TEST(HmiRequests, WellFormedRequestsAreParsed) {
-  Request r;
-  std::string error;
-  CHECK(parse_request(R"({"type":"set","name":"force_limit","value":2.5})", r, error));
-  CHECK(r.kind == RequestKind::Set);
-  CHECK(r.parameter == Parameter::ForceLimit);
-  DOUBLES_EQUAL(2.5, r.value, 0.0);
-  CHECK(command_kind(r.parameter) == control::CommandKind::SetForceLimit);
-  CHECK(parse_request(R"({"type":"set","name":"coupling","value":1})", r, error));
-  CHECK(r.parameter == Parameter::Coupling);
-  CHECK(parse_request(R"({"type":"reset"})", r, error));
-  CHECK(r.kind == RequestKind::Reset);
-}
-
-TEST(HmiRequests, MalformedMessagesAreRefusedWithWhatWasExpected) {
-  Request r;
-  std::string error;
-  const char* const bad[] = {
-      "", "not json", "{", "[]", "42", R"({"type":7})", R"({"kind":"reset"})", R"({"type":"launch"})",
-      R"({"type":"set"})", R"({"type":"set","name":"torque","value":1})", R"({"type":"set","name":"coupling"})",
-      R"({"type":"set","name":"coupling","value":"1"})", R"({"type":"set","name":"coupling","value":null})",
-      "\xff\xfe\x00garbage",
-  };
-  for (const char* text : bad) {
-    error.clear();
-    CHECK_FALSE_TEXT(parse_request(text, r, error), text);
-    CHECK_TEXT(!error.empty(), text);
-  }
-  CHECK_FALSE(parse_request(R"({"type":"launch"})", r, error));
-  CHECK(error.find("expected \"set\", \"reset\", \"stop\", \"pause\" or \"resume\"") != std::string::npos);
-  // Stop, pause and resume are requests of their own.
-  CHECK(parse_request(R"({"type":"stop"})", r, error));
-  CHECK(r.kind == RequestKind::Stop);
-  CHECK(parse_request(R"({"type":"pause"})", r, error));
-  CHECK(r.kind == RequestKind::Pause);
-  CHECK(parse_request(R"({"type":"resume"})", r, error));
-  CHECK(r.kind == RequestKind::Resume);
-  const std::string huge = R"({"type":"reset","pad":")" + std::string(2000, 'x') + "\"}";
-  CHECK_FALSE(parse_request(huge, r, error));
-  CHECK(error.find("at most 1024") != std::string::npos);
-}
-
-TEST(HmiRequests, ParametersBeyondTheBoardsLimitsAreRefusedWithTheReason) {
-  const HmiLimits limits{5.0, 1.0, 0.05, 2.0};
-  CHECK(refusal({RequestKind::Set, Parameter::ForceLimit, 5.0}, limits).empty());
-  CHECK(refusal({RequestKind::Set, Parameter::ForceLimit, 0.5}, limits).empty());
-  const std::string fifty = refusal({RequestKind::Set, Parameter::ForceLimit, 50.0}, limits);
-  STRCMP_CONTAINS("50 N is above the board's force limit of 5 N", fifty.c_str());
-  STRCMP_CONTAINS("above what the mill follows, 1 mm/s", refusal({RequestKind::Set, Parameter::SpeedLimit, 2.0}, limits).c_str());
-  CHECK(refusal({RequestKind::Set, Parameter::SpeedLimit, 0.5}, limits).empty());
-  STRCMP_CONTAINS("outside the coupling's range of 0.05 to 2 N/mm",
-                  refusal({RequestKind::Set, Parameter::Coupling, 3.0}, limits).c_str());
-  STRCMP_CONTAINS("must be a positive number", refusal({RequestKind::Set, Parameter::Coupling, -1.0}, limits).c_str());
-  STRCMP_CONTAINS("must be a positive number",
-                  refusal({RequestKind::Set, Parameter::ForceLimit, std::nan("")}, limits).c_str());
-  CHECK(refusal({RequestKind::Reset, Parameter::Coupling, 0.0}, limits).empty());
-}
 
 TEST_GROUP(HmiLiveState) {
   void setup() override { MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads(); }
@@ -326,23 +193,19 @@ TEST(HmiLiveState, StockChangesAreSentAsCellsAndASnapshotCarriesTheWholeGrid) {
   CHECK_EQUAL(first["stock_grid"]["heights"].size(), whole["stock_grid"]["heights"].size());
 }
 
-TEST(HmiLiveState, AResetMayBeAskedOnlyInASafeStateWithTheHandleStillNearTheTool) {
+TEST(HmiLiveState, ResetAndPauseAreRefusedWithoutAControllerAndOnceTheJobHasEnded) {
+  LiveState alone;
+  STRCMP_EQUAL("no controller", alone.reset_refusal().c_str());
+  STRCMP_EQUAL("no controller", alone.pause_refusal(display_link::RequestKind::Pause).c_str());
   Prism prism;
   Linked linked(prism.part, config());
   linked.publish();
   STRCMP_CONTAINS("the job has ended", linked.state.reset_refusal().c_str());  // publish() marks it ended
-  const display_link::ResetRule rule{config().still_time_s, config().reset_distance_mm};
-  control::Telemetry t{};
-  STRCMP_CONTAINS("not in a safe state", display_link::reset_refusal(false, t, rule).c_str());
-  t.safe_reason = control::SafeReason::DeviceStale;
-  t.device_still_s = 0.1;
-  t.device_to_tool_mm = 1.0;
-  STRCMP_CONTAINS("hold the handle still", display_link::reset_refusal(true, t, rule).c_str());
-  t.device_still_s = 1.0;
-  t.device_to_tool_mm = 12.0;
-  STRCMP_CONTAINS("12.0 mm away", display_link::reset_refusal(true, t, rule).c_str());
-  t.device_to_tool_mm = 2.0;
-  STRCMP_EQUAL("", display_link::reset_refusal(true, t, rule).c_str());
+  STRCMP_CONTAINS("the job has ended", linked.state.pause_refusal(display_link::RequestKind::Resume).c_str());
+  // The frame says the same to the page.
+  const nlohmann::json frame = linked.state.frame(1, nlohmann::json::object());
+  CHECK_FALSE(frame["safe"]["reset_allowed"].get<bool>());
+  STRCMP_EQUAL("the job has ended", frame["safe"]["reset_refusal"].get<std::string>().c_str());
 }
 
 TEST(HmiLiveState, TheEndOfTheJobIsShownWithItsLastState) {
@@ -357,73 +220,4 @@ TEST(HmiLiveState, TheEndOfTheJobIsShownWithItsLastState) {
   STRCMP_EQUAL("the job ended after 9 cycles", frame["controller"]["end"].get<std::string>().c_str());
   STRCMP_EQUAL("ended", frame["controller"]["state"].get<std::string>().c_str());
   CHECK_EQUAL(9U, frame["cycle"].get<std::uint64_t>());
-}
-
-TEST_GROUP(HmiTokenFile) {
-  void teardown() override { unsetenv("CREDENTIALS_DIRECTORY"); }  // however a test ended
-};
-
-TEST(HmiTokenFile, OnlyAFileItsOwnerAloneMayReadGivesAToken) {
-  Folder folder;
-  const std::string path = (folder.dir / "token").string();
-  std::ofstream(path) << "  s3cret-token \nsecond line\n";
-  std::string token, error;
-  chmod(path.c_str(), 0644);
-  CHECK_FALSE(read_token_file(path, token, error));
-  STRCMP_CONTAINS("mode 0644 lets others read it; chmod 600", error.c_str());
-  chmod(path.c_str(), 0600);
-  CHECK_TRUE_TEXT(read_token_file(path, token, error), error.c_str());
-  STRCMP_EQUAL("s3cret-token", token.c_str());
-  CHECK_FALSE(read_token_file((folder.dir / "missing").string(), token, error));
-  STRCMP_CONTAINS("No such file", error.c_str());
-  std::ofstream(path, std::ios::trunc) << "\n";
-  CHECK_FALSE(read_token_file(path, token, error));
-  STRCMP_CONTAINS("empty", error.c_str());
-  const std::string link = (folder.dir / "link").string();
-  CHECK(symlink(path.c_str(), link.c_str()) == 0);
-  CHECK_FALSE(read_token_file(link, token, error));  // never followed: it could point anywhere
-}
-
-// systemd's LoadCredential=: root's file with an ACL for the unit's user, so its mode shows the mask
-// (0440); taken as it is, but only straight from $CREDENTIALS_DIRECTORY.
-TEST(HmiTokenFile, ASystemdCredentialIsTakenAsSystemdLeftIt) {
-  Folder folder;
-  const std::string path = (folder.dir / "token").string();
-  std::ofstream(path) << "from-systemd\n";
-  chmod(path.c_str(), 0440);
-  std::string token, error;
-  CHECK_FALSE(read_token_file(path, token, error));
-  setenv("CREDENTIALS_DIRECTORY", folder.dir.c_str(), 1);
-  CHECK_TRUE_TEXT(read_token_file(path, token, error), error.c_str());
-  STRCMP_EQUAL("from-systemd", token.c_str());
-  std::filesystem::create_directory(folder.dir / "deeper");
-  const std::string deeper = (folder.dir / "deeper" / "token").string();
-  std::ofstream(deeper) << "x\n";
-  chmod(deeper.c_str(), 0440);
-  CHECK_FALSE(read_token_file(deeper, token, error));  // only the folder's own files
-  unsetenv("CREDENTIALS_DIRECTORY");
-}
-
-TEST_GROUP(DisplayApp) {
-  void setup() override { MemoryLeakWarningPlugin::saveAndDisableNewDeleteOverloads(); }
-  void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
-};
-
-TEST(DisplayApp, ABrowsersRequestIsCheckedHereBeforeAnythingGoesToTheController) {
-  DisplayAppOptions options;
-  options.controller_socket = "/nonexistent/display.sock";
-  options.quiet = true;
-  DisplayApp app(options);
-  nlohmann::json reply = nlohmann::json::parse(app.handle_message(1, true, "not json"));
-  STRCMP_EQUAL("error", reply["type"].get<std::string>().c_str());
-  reply = nlohmann::json::parse(app.handle_message(1, false, R"({"type":"reset"})"));
-  STRCMP_EQUAL("refused", reply["type"].get<std::string>().c_str());
-  STRCMP_CONTAINS("watch-only", reply["reason"].get<std::string>().c_str());
-  reply = nlohmann::json::parse(app.handle_message(1, true, R"({"type":"set","name":"coupling","value":0.5})"));
-  STRCMP_EQUAL("refused", reply["type"].get<std::string>().c_str());
-  STRCMP_CONTAINS("no controller to take it", reply["reason"].get<std::string>().c_str());
-  const DisplayCounters counters = app.counters();
-  CHECK_EQUAL(1U, counters.malformed);
-  CHECK_EQUAL(2U, counters.refused);
-  CHECK_EQUAL(0U, counters.forwarded);
 }
