@@ -123,15 +123,3 @@ TEST(MessageCodec, StopPauseAndResumeAreRequestsWithNoParameterAndNoValue) {
     STRCMP_CONTAINS("byte 16: expected 0 outside a Set", decode_error(bad).c_str());
   }
 }
-
-TEST(MessageCodec, APauseOrAResumeIsRefusedWhenTheCycleCannotTakeIt) {
-  stencil::control::Telemetry t{};
-  STRCMP_EQUAL("the job has not started yet", pause_refusal(RequestKind::Pause, false, t).c_str());
-  STRCMP_EQUAL("", pause_refusal(RequestKind::Pause, true, t).c_str());
-  STRCMP_EQUAL("not paused", pause_refusal(RequestKind::Resume, true, t).c_str());
-  t.paused = true;
-  STRCMP_EQUAL("already paused", pause_refusal(RequestKind::Pause, true, t).c_str());
-  STRCMP_EQUAL("", pause_refusal(RequestKind::Resume, true, t).c_str());
-  t.safe_reason = stencil::control::SafeReason::Stopped;
-  STRCMP_CONTAINS("in its safe state (stopped)", pause_refusal(RequestKind::Resume, true, t).c_str());
-}

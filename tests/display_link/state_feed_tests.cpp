@@ -1,14 +1,12 @@
-// The state feed: what the controller writes is what a display reads, never torn while written,
-// never writable by a display, and a region that is not a feed (or another build's) is refused.
+// The state feed: what the controller writes is what a display reads, never writable by a display,
+// and a region that is not a feed (or another build's) is refused. (Its cells' torn-read guard is
+// seqlock_tests.cpp's.)
 #include <sys/mman.h>
 
-#include <atomic>
 #include <cstring>
-#include <thread>
 #include <vector>
 
 #include "firmware/core/tables/table_loader.hpp"
-#include "firmware/services/display_link/seqlock.hpp"
 #include "firmware/services/display_link/state_feed.hpp"
 #include "tests/support/sample_tables.hpp"
 
@@ -118,38 +116,4 @@ TEST(StateFeed, ARegionThatIsNotThisBuildsFeedIsRefusedWithTheReason) {
   STRCMP_CONTAINS("bad magic", error.c_str());
   CHECK_FALSE(view.open_memory(copy.data(), 16, error));
   STRCMP_CONTAINS("too small", error.c_str());
-}
-
-// A reader racing the writer gets whole values only: each value written has every word equal.
-TEST(StateFeed, AReaderNeverSeesATornValue) {
-  struct Wide {
-    std::uint64_t words[64];
-  };
-  auto cell = std::make_unique<Seqlock<Wide>>();
-  std::atomic<bool> done{false};
-  std::thread writer([&] {
-    Wide value{};
-    for (std::uint64_t n = 1; n < 200000; ++n) {
-      std::fill(std::begin(value.words), std::end(value.words), n);
-      cell->write(value);
-    }
-    done = true;
-  });
-  std::uint64_t reads = 0, torn = 0, last = 0;
-  bool monotonic = true;
-  while (!done.load()) {
-    Wide seen{};
-    if (cell->try_read(seen)) {
-      ++reads;
-      for (const std::uint64_t word : seen.words) {
-        torn += word != seen.words[0] ? 1 : 0;
-      }
-      monotonic = monotonic && seen.words[0] >= last;
-      last = seen.words[0];
-    }
-  }
-  writer.join();
-  CHECK(reads > 0U);
-  CHECK_EQUAL(0U, torn);
-  CHECK(monotonic);
 }

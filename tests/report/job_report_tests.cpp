@@ -97,28 +97,3 @@ TEST(JobReport, TheRigsReportHasTheFiguresAndItsFaultsAndResets) {
   STRCMP_EQUAL("deadbeef", made["tables"]["crc32"].get<std::string>().c_str());
   CHECK_EQUAL(24, made["tables"]["triangles"].get<int>());
 }
-
-TEST(JobReport, ProvenanceAsOneLineForTheJournalQuotesWhatAShellWouldSplit) {
-  report::Provenance p;
-  p.program = "stencil-sim";
-  p.command_line = {"stencil-sim", "--fast", "--operator", "it's here.csv"};
-  p.tables = "(baked-in hex prism)";
-  p.tables_crc32 = 0x00c0ffeeU;
-  p.triangle_count = 24;
-  const std::string line = report::provenance_line(p);
-  STRCMP_CONTAINS((std::string("stencil-sim ") + report::source_version() + " (").c_str(), line.c_str());
-  STRCMP_CONTAINS("; configuration compiled-in;", line.c_str());
-  STRCMP_CONTAINS("tables '(baked-in hex prism)' crc32=00c0ffee triangles=24;", line.c_str());
-  STRCMP_CONTAINS("command: stencil-sim --fast --operator 'it'\\''s here.csv'", line.c_str());
-  STRCMP_EQUAL("compiled-in", report::provenance_json(p)["configuration"].get<std::string>().c_str());
-  // A newline cannot break the line; a command line too long for a record is cut after a whole
-  // argument, and says so.
-  p.command_line = {"stencil-sim", "--operator", "two\nlines.csv"};
-  STRCMP_CONTAINS("command: stencil-sim --operator 'two?lines.csv'", report::provenance_line(p).c_str());
-  CHECK(report::provenance_line(p).find('\n') == std::string::npos);
-  p.command_line.assign(2000, "--seed=12345");
-  const std::string cut = report::provenance_line(p);
-  CHECK(cut.size() <= 4000U);
-  CHECK(cut.size() > 3980U);
-  STRCMP_CONTAINS("--seed=12345 ...", cut.substr(cut.size() - 20).c_str());
-}
