@@ -24,13 +24,38 @@ die() { echo "mutation-check: $*" >&2; exit 2; }
 
 [ -f "$table" ] || die "no $table"
 mkdir -p "$work" || die "cannot make $work"
-# A copy of the tree as it is now (committed and not), so the check runs on what is being changed.
-[ -d "$build" ] && mv "$build" "$work/kept-build"  # keep the build between runs
-rm -rf "$src"
+# A copy of the tree as it is now (committed and not), so the check runs on what is being changed;
+# kept between runs with its build. Only a file whose bytes differ is written (so it is newer than
+# what was built from it: a line a run put back, or a file changed since, is rebuilt), and a file
+# the tree no longer has is removed.
 mkdir -p "$src" || die "cannot make $src"
-(cd "$root" && git ls-files -co --exclude-standard -z | tar --null -T - -cf -) | tar -xf - -C "$src" ||
-  die "cannot copy the tree to $src"
-[ -d "$work/kept-build" ] && mv "$work/kept-build" "$build"
+(cd "$root" && git ls-files -co --exclude-standard -z) | python3 -c '
+import os, sys
+root, src = sys.argv[1:3]
+wanted = set()
+for path in sys.stdin.buffer.read().split(b"\0"):
+    if not path:
+        continue
+    path = path.decode()
+    wanted.add(path)
+    source, copy = os.path.join(root, path), os.path.join(src, path)
+    if not os.path.isfile(source):
+        continue
+    data = open(source, "rb").read()
+    if os.path.isfile(copy) and open(copy, "rb").read() == data:
+        continue
+    os.makedirs(os.path.dirname(copy), exist_ok=True)
+    open(copy, "wb").write(data)
+    os.chmod(copy, os.stat(source).st_mode & 0o777)
+for folder, dirs, files in os.walk(src):
+    if folder == os.path.join(src, "build") or folder.startswith(os.path.join(src, "build") + os.sep):
+        dirs[:] = []
+        continue
+    for name in files:
+        path = os.path.relpath(os.path.join(folder, name), src)
+        if path not in wanted:
+            os.remove(os.path.join(folder, name))
+' "$root" "$src" || die "cannot copy the tree to $src"
 launcher=()
 command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache -DCMAKE_C_COMPILER_LAUNCHER=ccache)
 cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DSTENCIL_BUILD_TESTS=ON "${launcher[@]}" \
@@ -43,6 +68,12 @@ while IFS= read -r line; do
   rows+=("$line")
 done <"$table"
 [ "${#rows[@]}" -gt 0 ] || die "$table holds no mutation"
+# The files a run mutates are rebuilt once first: an object built from a mutation is newer than the
+# line put back by a run that was stopped, or than a copy older than that run.
+for row in "${rows[@]}"; do
+  IFS=$'\t' read -r _ file _ <<<"$row"
+  touch "$src/$file"
+done
 
 split() {  # row -> behaviour file from to test target
   IFS=$'\t' read -r behaviour file from to test <<<"$1"
