@@ -295,6 +295,9 @@ bool parse_operator_csv(std::istream& in, const std::string& path, OperatorScrip
   int number = 0;
   while (std::getline(in, line)) {
     ++number;
+    if (!line.empty() && line.back() == '\r') {
+      line.pop_back();  // a file written on Windows: its blank lines are blank too
+    }
     if (line.empty() || line[0] == '#' || (number == 1 && line.rfind("t_s", 0) == 0)) {
       continue;  // comments and a header line
     }
@@ -309,6 +312,11 @@ bool parse_operator_csv(std::istream& in, const std::string& path, OperatorScrip
         return false;
       }
       values.push_back(value);
+    }
+    if (line.back() == ',') {  // getline gives no empty last field: a row is not guessed complete
+      error = path + ": line " + std::to_string(number) + ": field " + std::to_string(values.size() + 1) +
+              " '' is not a finite number";
+      return false;
     }
     if (values.size() != 4 && values.size() != 6) {
       error = path + ": line " + std::to_string(number) + ": " + std::to_string(values.size()) +

@@ -61,6 +61,16 @@ TEST(OperatorScript, ABadFieldIsNamedWithItsFileLineAndPlace) {
   STRCMP_EQUAL("ops.csv: line 1: field 3 'nan' is not a finite number", parse_error("0,1,nan,3\n").c_str());
   STRCMP_EQUAL("ops.csv: line 1: field 2 '1e999' is not a finite number", parse_error("0,1e999,2,3\n").c_str());
   STRCMP_EQUAL("ops.csv: line 1: field 2 '' is not a finite number", parse_error("0,,2,3\n").c_str());
+  // An empty last field is refused as well, not read as a row of four (getline drops it).
+  STRCMP_EQUAL("ops.csv: line 2: field 5 '' is not a finite number", parse_error("0,1,2,3\n1,1,2,3,\n").c_str());
+}
+
+TEST(OperatorScript, AFileWithWindowsLineEndsReadsAsItsRowsBlankLinesIncluded) {
+  OperatorScript script;
+  STRCMP_EQUAL("", parse("t_s,x_mm,y_mm,z_mm\r\n0,1,2,3\r\n\r\n1,4,5,6\r\n", script).c_str());
+  LONGS_EQUAL(2, script.t_s.size());
+  DOUBLES_EQUAL(6.0, script.device_mm[1].z(), 0.0);
+  STRCMP_EQUAL("ops.csv: line 2: field 2 'x' is not a finite number", parse_error("0,1,2,3\r\n1,x,2,3\r\n").c_str());
 }
 
 TEST(OperatorScript, AWrongFieldCountTimesThatDoNotIncreaseAndNoRowsAreRefused) {
