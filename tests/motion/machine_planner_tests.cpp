@@ -31,8 +31,6 @@ MachineFrames sherline_frames() { return {10.0, Eigen::Vector3d::Zero(), kHome, 
 
 PlannerLimits sherline_limits() { return {{1.4, 1000.0, 640.0}, 1.0 / 30.0, {80, 32, 80}}; }
 
-constexpr std::int32_t kAxisBudget = 29;   // floor(1.4 mm/s * 640 steps/mm / 30 Hz)
-constexpr std::int32_t kTotalBudget = 33;  // floor(1000 steps/s / 30 Hz)
 
 struct Loaded {
   tablegen::TableBytes bytes;
@@ -73,6 +71,23 @@ void check_staircase(const tables::PartTables& part, const MachineFrames& frames
   }
 }
 
+// Every point of the straight segment from `from` to `to`, checked every 2 um the same way.
+void check_straight(const tables::PartTables& part, const MachineFrames& frames, const MachineSteps& from,
+                    const MachineSteps& to) {
+  const Eigen::Vector3d a = steps_to_world(frames, from);
+  const Eigen::Vector3d b = steps_to_world(frames, to);
+  const int pieces = std::max(1, static_cast<int>(std::ceil((b - a).norm() / 0.002)));
+  for (int k = 0; k <= pieces; ++k) {
+    const Eigen::Vector3d at = a + (b - a) * (static_cast<double>(k) / pieces);
+    CHECK(engine::check_tip_legal(part, at) == engine::Legality::Legal);
+    CHECK(test::ball_end_gouge_mm(part, at) <= part.header.gouge_bound_mm + 1e-5);
+  }
+}
+
+// A mill that moves like LinuxCNC's: the CY545 rig's speed per axis, but no limit on the sum of the
+// axes' steps (a coordinated move), no backlash (LinuxCNC takes its own up), straight segments.
+PlannerLimits straight_limits() { return {{1.4, 3000.0, 640.0}, 1.0 / 30.0, {0, 0, 0}, MachinePath::Straight}; }
+
 struct Run {
   std::vector<PlanResult> updates;
   std::vector<MachineSteps> axis_before;
@@ -81,8 +96,11 @@ struct Run {
 // Drives the planner at 30 Hz from a virtual tool fed at 1 kHz: every update's limits and staircase
 // are checked; the link completes each target before the next update.
 Run drive(MachinePlanner& planner, const tables::PartTables& part, const std::vector<Eigen::Vector3d>& virtual_path,
-          int extra_updates) {
+          int extra_updates, const PlannerLimits& limits = sherline_limits()) {
   const MachineFrames frames = sherline_frames();
+  const auto axis_budget = static_cast<std::int32_t>(
+      std::floor(limits.speed.max_axis_speed_mm_per_s * limits.update_period_s * limits.speed.steps_per_mm));
+  const auto total_budget = static_cast<std::int32_t>(std::floor(limits.speed.step_rate_steps_per_s * limits.update_period_s));
   Run run;
   const auto update = [&]() {
     const MachineSteps before = planner.axis_steps();
@@ -92,12 +110,14 @@ Run drive(MachinePlanner& planner, const tables::PartTables& part, const std::ve
     std::int32_t total = 0;
     for (std::size_t i = 0; i < 3; ++i) {
       const std::int32_t motor_move = std::abs(r.motor_target.axis[i] - motor_before.axis[i]);
-      CHECK(motor_move <= kAxisBudget);
+      CHECK(motor_move <= axis_budget);
       total += motor_move;
     }
-    CHECK(total <= kTotalBudget);
+    CHECK(total <= total_budget);
     CHECK_EQUAL(total, r.motor_steps);
-    if (r.status == PlanStatus::Moved) {
+    if (r.status == PlanStatus::Moved && limits.path == MachinePath::Straight) {
+      check_straight(part, frames, before, r.axis_target);
+    } else if (r.status == PlanStatus::Moved) {
       check_staircase(part, frames, before, r.axis_target, r.order);
     } else {
       CHECK(r.axis_target == before);  // nothing but a move moves the tool
@@ -345,10 +365,10 @@ std::vector<Eigen::Vector3d> pressed_path(const tables::PartTables& part, const 
 // stalled: the tool rides the edge a micrometre off it), round a vertex low on the walls, and down
 // into the concave corner of a wall and the floor from several directions; the mill follows at
 // 30 Hz (every staircase checked in drive()). Returns the updates that found no way.
-int blocked_following_a_pressed_tool(double standoff_mm) {
+int blocked_following_a_pressed_tool(double standoff_mm, const PlannerLimits& limits = sherline_limits()) {
   const Loaded loaded;
   const tables::PartTables& part = loaded.part;
-  MachinePlanner planner(part, sherline_frames(), sherline_limits());
+  MachinePlanner planner(part, sherline_frames(), limits);
   const MachineFrames frames = sherline_frames();
   const Eigen::Vector3d start(17.7, 9.8, 7.0);
   MachineSteps start_steps{};
@@ -360,15 +380,16 @@ int blocked_following_a_pressed_tool(double standoff_mm) {
       {32.0, 14.0, -2.0},   {30.5, 17.0, -1.5},  {31.5, 13.0, -0.5},  {31.0, 16.0, -3.0},  {29.0, 18.0, -1.0}};
   const std::vector<Eigen::Vector3d> path =
       pressed_path(part, steps_to_world(frames, start_steps), waypoints, standoff_mm);
-  const Run run = drive(planner, part, path, 300);
+  const Run run = drive(planner, part, path, 300, limits);
   int blocked = 0;
   for (const PlanResult& r : run.updates) {
     blocked += r.status == PlanStatus::Blocked ? 1 : 0;
   }
   const Eigen::Vector3d reached = steps_to_world(frames, planner.axis_steps());
   std::printf("\n  pressed over the prism's edge, round a vertex and into its corner with the floor, standoff "
-              "%.3f mm: %zu updates, %d blocked, the mill ends %.4f mm from the virtual tool\n",
-              standoff_mm, run.updates.size(), blocked, (reached - path.back()).norm());
+              "%.3f mm, %s: %zu updates, %d blocked, the mill ends %.4f mm from the virtual tool\n",
+              standoff_mm, limits.path == MachinePath::Straight ? "straight segments" : "staircases",
+              run.updates.size(), blocked, (reached - path.back()).norm());
   return blocked;
 }
 
@@ -379,3 +400,78 @@ TEST(MachinePlanner, WithTheStandoffTheMillFollowsAToolPressedIntoTheFloorsCorne
   CHECK_EQUAL(0, blocked_following_a_pressed_tool(0.015));
 }
 
+
+// A mill that moves in straight segments (LinuxCNC) gets each segment checked, not a staircase:
+// pressed the same way, every segment is legal at 2 um (drive() checks it) and none blocks.
+TEST(MachinePlanner, StraightSegmentsAreCheckedAsTheMillMovesThemAndTheMillFollowsAPressedTool) {
+  CHECK_EQUAL(0, blocked_following_a_pressed_tool(0.015, straight_limits()));
+}
+
+// Beside the prism's vertex, a target one update away whose straight segment cuts the vertex: the
+// straight mill does not go there, while a staircase mill goes round the vertex. (A one-second update,
+// so that the way round is in reach: within a 30 Hz update's 0.045 mm a chord of the tool's path
+// round the vertex strays into the part by far less than the tables' tolerance.)
+TEST(MachinePlanner, AStraightSegmentThatCutsTheCornerIsNotTaken) {
+  const Loaded loaded;
+  const tables::PartTables& part = loaded.part;
+  const MachineFrames frames = sherline_frames();
+  // The vertex of the prism at (33, 12.5): the tool's side against both walls, 2 mm up.
+  const std::vector<Eigen::Vector3d> around =
+      virtual_path(part, Eigen::Vector3d(33.0, 9.5, 2.0), {Eigen::Vector3d(31.5, 12.5, 2.0), Eigen::Vector3d(31.0, 16.5, 2.0)}, 0.8);
+  bool found = false;
+  MachineSteps from{};
+  MachineSteps to{};
+  for (std::size_t i = 0; i < around.size() && !found; i += 50) {
+    for (std::size_t j = i + 50; j < around.size() && !found; j += 50) {
+      MachineSteps a{};
+      MachineSteps b{};
+      CHECK(world_to_steps(frames, around[i], a));
+      CHECK(world_to_steps(frames, around[j], b));
+      bool fits = true;
+      for (std::size_t k = 0; k < 3; ++k) {
+        fits = fits && std::abs(b.axis[k] - a.axis[k]) <= 800;
+      }
+      if (!fits) {
+        break;
+      }
+      const Eigen::Vector3d wa = steps_to_world(frames, a);
+      const Eigen::Vector3d wb = steps_to_world(frames, b);
+      if (engine::check_tip_legal(part, wa) != engine::Legality::Legal ||
+          engine::check_tip_legal(part, wb) != engine::Legality::Legal) {
+        continue;
+      }
+      const auto legal = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& q) {
+        return engine::check_sweep(part, p, q, engine::sweep_step_mm(part), 100000).status == engine::SweepStatus::Legal;
+      };
+      const Eigen::Vector3d x_first(wb.x(), wa.y(), wa.z());
+      const Eigen::Vector3d y_first(wa.x(), wb.y(), wa.z());
+      const bool round_it = (legal(wa, x_first) && legal(x_first, wb)) || (legal(wa, y_first) && legal(y_first, wb));
+      if (!legal(wa, wb) && round_it && wa.z() == wb.z()) {
+        from = a;
+        to = b;
+        found = true;
+      }
+    }
+  }
+  CHECK_TEXT(found, "no chord across the vertex within one update: the test's set-up is wrong");
+  const auto plan_to = [&](const PlannerLimits& limits) {
+    MachinePlanner planner(part, frames, limits);
+    planner.homed(from, {1, 1, 1});
+    CHECK(planner.follow(steps_to_world(frames, to)) == PathStatus::Added);
+    return planner.plan(0);
+  };
+  PlannerLimits staircase = sherline_limits();
+  staircase.backlash_steps = {0, 0, 0};
+  staircase.update_period_s = 1.0;
+  PlannerLimits straight = straight_limits();
+  straight.update_period_s = 1.0;
+  const PlanResult by_staircase = plan_to(staircase);
+  const PlanResult by_segment = plan_to(straight);
+  CHECK(by_staircase.status == PlanStatus::Moved);
+  CHECK(by_staircase.axis_target == to);
+  check_staircase(part, frames, from, to, by_staircase.order);
+  CHECK_FALSE(by_segment.status == PlanStatus::Moved && by_segment.axis_target == to);
+  if (by_segment.status == PlanStatus::Moved) {
+    check_straight(part, frames, from, by_segment.axis_target);
+  }
+}

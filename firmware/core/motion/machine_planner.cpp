@@ -18,6 +18,20 @@ constexpr int kMaxLegSubSteps = 64;
 
 int sign_of(std::int32_t value) { return value > 0 ? 1 : (value < 0 ? -1 : 0); }
 
+// A straight segment is at most one update's budget long: its length over the sweep's step, plus
+// one for the rounding, bounds its sub-steps (capped, so that bad limits cannot make the work
+// unbounded: a longer segment is then Limited, so not taken).
+constexpr int kMaxStraightSubSteps = 4096;
+int straight_sub_steps_for(std::int32_t axis_budget, std::int32_t total_budget, double steps_per_mm, double sweep_step_mm) {
+  const double axis = static_cast<double>(std::max(axis_budget, 0));
+  const double longest_steps = std::min(std::sqrt(3.0) * axis, static_cast<double>(std::max(total_budget, 0)));
+  const double sub_steps = std::ceil(longest_steps / steps_per_mm / sweep_step_mm) + 1.0;
+  if (!(sub_steps >= 1.0)) {
+    return 1;
+  }
+  return sub_steps > kMaxStraightSubSteps ? kMaxStraightSubSteps : static_cast<int>(sub_steps);
+}
+
 }  // namespace
 
 MachinePlanner::MachinePlanner(const tables::PartTables& part, const MachineFrames& frames, const PlannerLimits& limits)
@@ -27,7 +41,8 @@ MachinePlanner::MachinePlanner(const tables::PartTables& part, const MachineFram
       sweep_step_mm_(engine::sweep_step_mm(part)),
       axis_budget_(static_cast<std::int32_t>(std::floor(limits.speed.max_axis_speed_mm_per_s * limits.update_period_s *
                                                         limits.speed.steps_per_mm))),
-      total_budget_(static_cast<std::int32_t>(std::floor(limits.speed.step_rate_steps_per_s * limits.update_period_s))) {}
+      total_budget_(static_cast<std::int32_t>(std::floor(limits.speed.step_rate_steps_per_s * limits.update_period_s))),
+      straight_sub_steps_(straight_sub_steps_for(axis_budget_, total_budget_, limits.speed.steps_per_mm, sweep_step_mm_)) {}
 
 void MachinePlanner::homed(const MachineSteps& at, const std::array<int, 3>& approach) {
   homed_ = true;
@@ -186,6 +201,18 @@ bool MachinePlanner::corner_target(const Eigen::Vector3d& exact, MachineSteps& t
 // The first order whose staircase from the current position to `to` (itself legal) is legal, leg
 // by leg; -1 when none is (or the tables fault: the caller cannot tell, and holds either way).
 int MachinePlanner::legal_order(const MachineSteps& to, AxisOrder& order, PlanSearch& search) const {
+  if (limits_.path == MachinePath::Straight) {
+    ++search.staircases;
+    ++search.legs;
+    const engine::SweepResult segment = engine::check_sweep(part_, steps_to_world(frames_, axis_),
+                                                            steps_to_world(frames_, to), sweep_step_mm_,
+                                                            straight_sub_steps_);
+    if (segment.status != engine::SweepStatus::Legal) {
+      return -1;
+    }
+    order = kOrders[0];
+    return 0;
+  }
   std::array<bool, 6> seen_paths{};
   for (std::size_t o = 0; o < kOrders.size(); ++o) {
     // Orders that differ only where an axis does not move are the same path.

@@ -21,10 +21,18 @@ namespace stencil::motion {
 // rounding) from the virtual tool.
 inline constexpr double kReversalDeadbandSteps = 4.0;
 
+// How the mill moves between two targets, so the planner checks the path it really takes.
+enum class MachinePath : std::uint8_t {
+  Staircase,  // one axis at a time, in the order the planner chose (the CY545 steps so)
+  Straight,   // one coordinated straight segment (LinuxCNC's G1 in exact-path mode, G61)
+};
+
 struct PlannerLimits {
   MachineSpeed speed;
   double update_period_s;                     // one machine update (1/30 s on the rig)
-  std::array<std::int32_t, 3> backlash_steps; // slack per axis, taken up on every reversal
+  std::array<std::int32_t, 3> backlash_steps; // slack per axis, taken up on every reversal (0 where
+                                              // the controller compensates its own, as LinuxCNC does)
+  MachinePath path = MachinePath::Staircase;
 };
 
 // Why the mill can always follow a virtual tool that keeps a standoff s from the part
@@ -46,7 +54,9 @@ struct PlannerLimits {
 //    axis: within sqrt(3) times that of a, which is within s: legal, as is c. The move is under
 //    kReversalDeadbandSteps + 4 steps per axis: inside one update's budget (follow_fallback_fits).
 // So some staircase is always legal, the planner finds it (it tries every corner and order), and
-// the mill never stalls while the virtual tool moves legally. The standoff that takes:
+// the mill never stalls while the virtual tool moves legally. A mill that moves in straight
+// segments (MachinePath::Straight) is covered by the same argument: the segment from g to c lies
+// axis by axis between them too. The standoff that takes:
 constexpr double follow_standoff_needed_mm(double steps_per_mm, double max_axis_move_per_cycle_mm) {
   const double step_mm = 1.0 / steps_per_mm;
   if (!(max_axis_move_per_cycle_mm <= step_mm)) {
@@ -109,7 +119,7 @@ enum class PathStatus : std::uint8_t {
 // Owned by the machine side: its own read-only view of the tables, its own engine scratch (each
 // legality query), never the touched set. Allocation-free after construction; plan() tries at most
 // kMaxCandidates + 1 candidates x 8 corners x 6 orders x 3 legs sweeps, each of a bounded number of
-// sub-steps.
+// sub-steps (MachinePath::Straight: candidates x 8 corners x 1 sweep of at most straight_sub_steps()).
 class MachinePlanner {
  public:
   static constexpr std::size_t kPathCapacity = 4096;  // points at least a step apart: seconds of motion
@@ -136,6 +146,8 @@ class MachinePlanner {
   [[nodiscard]] int queued() const { return queued_; }
   // The newest virtual tool tip handed to follow().
   [[nodiscard]] const Eigen::Vector3d& newest_mm() const { return newest_mm_; }
+  // The most sub-steps a straight segment's sweep checks: enough for one update's longest move.
+  [[nodiscard]] int straight_sub_steps() const { return straight_sub_steps_; }
   // What the last plan() that returned Blocked tried.
   [[nodiscard]] const PlanSearch& last_blocked_search() const { return blocked_search_; }
 
@@ -162,6 +174,7 @@ class MachinePlanner {
   double sweep_step_mm_;
   std::int32_t axis_budget_;   // steps one axis may make in an update (its speed)
   std::int32_t total_budget_;  // steps all axes together may make in an update (the step rate)
+  int straight_sub_steps_;
   bool homed_ = false;
   MachineSteps axis_{};                 // commanded tool position, steps
   MachineSteps motor_{};                // commanded motor position, steps
