@@ -39,6 +39,9 @@ enum class MachineFault : std::uint8_t {
   PortClosed,        // the port hung up (unplugged)
   WriteFailed,       // the port would not take the bytes within the bound
   PositionMismatch,  // the controller's position differs from the commanded one
+  EstopPressed,      // the controller's own e-stop (LinuxCNC: ESTOP ON)
+  ControllerError,   // the controller reported an error or turned its machine off (its words: the link's last error)
+  CommandRefused,    // the controller refused a command (linuxcncrsh: SET ... NAK, HELLO NAK)
 };
 
 // Why a call did nothing (besides a fault).

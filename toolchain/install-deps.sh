@@ -50,6 +50,7 @@ packages=(
   fonts-dejavu-core  # text in that browser's screenshots
   help2man           # make package: man pages from the programs' --help
   dpkg-dev           # make package: dpkg-shlibdeps finds the package's runtime dependencies
+  linuxcnc-uspace    # the LinuxCNC backend's tests run the real LinuxCNC (sim/linuxcnc_mill; about 80 MB)
 )
 # The display's page is built with npm (three.js and esbuild, pinned by its package-lock.json): the
 # machine's own Node.js and npm when it has them, else Debian's (Node 18 on Debian 12: every package
