@@ -13,6 +13,7 @@ NAME="${LCNC_SIM_NAME:-SIMMILL}"
 SESSIONS="${LCNC_SIM_SESSIONS:--1}"
 SIM_USER="${LCNC_SIM_USER:-nobody}"
 START_TIMEOUT="${LCNC_SIM_START_TIMEOUT:-30}"
+LOOPBACK_ONLY="${LCNC_SIM_LOOPBACK_ONLY:-0}"
 STOP_TIMEOUT="${LCNC_SIM_STOP_TIMEOUT:-10}"
 
 # LinuxCNC's own fixed host-wide state (the linuxcnc script and rtapi hard-code these).
@@ -64,6 +65,10 @@ Options (or the environment variables):
                                            the count never goes down, so N limits connections ever)
   --user USER         LCNC_SIM_USER        user LinuxCNC runs as when started by root (default nobody)
   --timeout S         LCNC_SIM_START_TIMEOUT  start's bounded wait (default 30)
+  --loopback-only     LCNC_SIM_LOOPBACK_ONLY=1  linuxcncrsh always listens on every address
+                      (0.0.0.0, no option to change it): as root, start inserts
+                        iptables -I INPUT -p tcp --dport PORT ! -i lo -j REJECT --reject-with tcp-reset
+                      and stop deletes it (off by default: it changes the host's firewall)
   -h, --help
 
 Files in DIR: mill.ini mill.hal mill.nml mill.tbl mill.var (config), linuxcnc.log (LinuxCNC's
@@ -87,6 +92,7 @@ while [ $# -gt 0 ]; do
         --sessions) SESSIONS="$2"; shift 2 ;;
         --user) SIM_USER="$2"; shift 2 ;;
         --timeout) START_TIMEOUT="$2"; shift 2 ;;
+        --loopback-only) LOOPBACK_ONLY=1; shift ;;
         --) shift; ARGS+=("$@"); break ;;
         *) ARGS+=("$1"); shift ;;
     esac
@@ -99,9 +105,11 @@ case "$CMD" in
 esac
 [ $# -ge 1 ] || die "$CMD needs DIR (try --help)"
 DIR_ARG="$1"; shift
-mkdir -p "$DIR_ARG" 2>/dev/null || true
-[ -d "$DIR_ARG" ] || die "cannot use $DIR_ARG as the instance folder"
-DIR="$(cd "$DIR_ARG" && pwd -P)"
+if [ "$CMD" = start ]; then
+    mkdir -p "$DIR_ARG" 2>/dev/null || true
+    [ -d "$DIR_ARG" ] || die "cannot use $DIR_ARG as the instance folder"
+fi
+if [ -d "$DIR_ARG" ]; then DIR="$(cd "$DIR_ARG" && pwd -P)"; else DIR="$(realpath -m "$DIR_ARG")"; fi
 
 # ---- who runs LinuxCNC
 if [ "$(id -u)" = 0 ]; then
@@ -159,12 +167,25 @@ cleanup_host_state() {
 
 hello_ok() {   # one hello on the port; true if HELLO ACK comes back within 2 s
     local line=""
-    exec 3<>"/dev/tcp/127.0.0.1/$PORT" 2>/dev/null || return 1
+    { exec 3<>"/dev/tcp/127.0.0.1/$PORT"; } 2>/dev/null || return 1
     printf 'hello %s lcnc-sim-probe 1.1\r\n' "$CONNECTPW" >&3
     IFS= read -r -t 2 line <&3 || true
-    printf 'quit\r\n' >&3 2>/dev/null || true
     exec 3<&- 3>&-
     [[ "$line" == "HELLO ACK"* ]]
+}
+
+FW_RULE=(INPUT -p tcp --dport "$PORT" ! -i lo -j REJECT --reject-with tcp-reset)
+firewall_on() {
+    [ "$(id -u)" = 0 ] || die "--loopback-only needs root (iptables)"
+    command -v iptables >/dev/null || die "--loopback-only needs iptables"
+    iptables -C "${FW_RULE[@]}" 2>/dev/null || iptables -I "${FW_RULE[@]}" || die "iptables could not add the rule"
+}
+firewall_off() {   # the rule start added, if sim.env says so
+    local p
+    [ -f "$DIR/sim.env" ] && grep -qx 'loopback_only=1' "$DIR/sim.env" || return 0
+    p="$(sed -n 's/^port=//p' "$DIR/sim.env")"
+    [ -n "$p" ] && command -v iptables >/dev/null || return 0
+    while iptables -D INPUT -p tcp --dport "$p" ! -i lo -j REJECT --reject-with tcp-reset 2>/dev/null; do :; done
 }
 
 cmd_start() {
@@ -186,11 +207,16 @@ cmd_start() {
     fi
     # stale state from a LinuxCNC that died
     cleanup_host_state
+    firewall_off
 
     # fresh config in DIR
     rm -f "$DIR/samples.txt" "$DIR/linuxcnc.log" "$DIR/halsampler.log" "$DIR/sim.env" \
         "$DIR/linuxcnc_debug.txt" "$DIR/linuxcnc_print.txt" "$DIR/.tool.mmap" "$DIR/mill.var"
     cp "$HERE/mill.ini" "$HERE/mill.hal" "$HERE/mill.nml" "$HERE/mill.tbl" "$DIR/" || die "cannot copy the config to $DIR"
+    if [ "$LOOPBACK_ONLY" = 1 ]; then
+        firewall_on
+        printf 'port=%s\nloopback_only=1\n' "$PORT" > "$DIR/sim.env"   # so stop removes the rule
+    fi
     sed -i -e "s|@PORT@|$PORT|" -e "s|@NAME@|$NAME|" -e "s|@CONNECTPW@|$CONNECTPW|" \
         -e "s|@ENABLEPW@|$ENABLEPW|" -e "s|@SESSIONS@|$SESSIONS|" "$DIR/mill.ini"
     if [ "$(id -u)" = 0 ]; then
@@ -244,6 +270,7 @@ cmd_start() {
         echo "linuxcnc_pid=$lpid"
         echo "linuxcncrsh_pid=$rshpid"
         echo "halsampler_pid=$spid"
+        echo "loopback_only=$LOOPBACK_ONLY"
         echo "dir=$DIR"
         echo "samples=$DIR/samples.txt"
         echo "log=$DIR/linuxcnc.log"
@@ -292,6 +319,7 @@ cmd_stop() {
     kill_instance || true
     [ -n "$lpid" ] && wait "$lpid" 2>/dev/null
     cleanup_host_state
+    firewall_off
     rm -f "$DIR/linuxcnc.pid" "$DIR/halsampler.pid"
     if [ -n "$(instance_pids)" ]; then echo "$PROG: stop failed, processes left: $(instance_pids)" >&2; exit 1; fi
     echo "stop_seconds=$(elapsed "$t0")"
