@@ -8,6 +8,7 @@
 #include <string>
 
 #include "board/sim/sim_job.hpp"
+#include "board/sim/sim_machine.hpp"
 #include "firmware/runtime/job_hooks.hpp"
 #include "hal/clock.hpp"
 #include "hal/cy545/cy545_link.hpp"
@@ -23,7 +24,7 @@ namespace stencil::board::sim {
 
 // After each machine update, the leg the mill is cutting is flushed into the machined part (a hook
 // of the job's run).
-class MillWiring final : public runtime::JobHooks {
+class MillWiring final : public SimMachine {
  public:
   // In virtual time the fake follows the machine side's clock (FakeCy545Clock), which gives its bytes
   // their wire time and its commands the chip's; in real time the wall clock, and it answers from a
@@ -32,31 +33,32 @@ class MillWiring final : public runtime::JobHooks {
   ~MillWiring();
 
   // Empty when the driver's port is open; else why not.
-  [[nodiscard]] const std::string& error() const { return error_; }
-  [[nodiscard]] hal::cy545::Cy545Link& link() { return *link_; }
+  [[nodiscard]] const std::string& error() const override { return error_; }
+  [[nodiscard]] hal::cy545::Cy545Link& link() override { return *link_; }
   [[nodiscard]] const hal::cy545::Cy545Link& link() const { return *link_; }
-  [[nodiscard]] hal::Clock& clock() { return fast_clock_ ? static_cast<hal::Clock&>(*fast_clock_) : wall_clock_; }
+  [[nodiscard]] const char* link_error() const override { return link_->last_error(); }
+  [[nodiscard]] hal::Clock& clock() override { return fast_clock_ ? static_cast<hal::Clock&>(*fast_clock_) : wall_clock_; }
   // Virtual time only (in real time the fake's thread owns it): the fault hooks at the line's far end.
   [[nodiscard]] stencil::sim::cy545::FakeCy545& fake() { return fake_; }
-  [[nodiscard]] stencil::sim::MachinedPart& machined() { return machined_; }
-  [[nodiscard]] const stencil::sim::MachinedPart& machined() const { return machined_; }
+  [[nodiscard]] stencil::sim::MachinedPart& machined() override { return machined_; }
+  [[nodiscard]] const stencil::sim::MachinedPart& machined() const override { return machined_; }
   // The simulated mill itself (virtual time: no thread of the fake's is running), for what a person
   // at it would see.
   [[nodiscard]] const stencil::sim::SimulatedMill& mill() const { return mill_; }
 
   // Real time: the fake answers from its own thread until stop_answering().
-  void start_answering();
-  void stop_answering();
+  void start_answering() override;
+  void stop_answering() override;
 
   // Once homed: the machined part counts from where the mill is now.
-  void arm();
+  void arm() override;
 
   void after_machine_update() override;
 
   // At the end, once the machine side has stopped the mill (at now_ns): its power as the board's
   // latches leave it, then a second later, when the watchdog relay has dropped what the driver could
   // not turn off because its heartbeat stopped with the job. What the machinist finds at the mill.
-  void leave(SimResult& result, bool stop_confirmed, hal::MonotonicNs now_ns);
+  void leave(SimResult& result, bool stop_confirmed, hal::MonotonicNs now_ns) override;
 
  private:
   // Runs `inspect()` with the fake's thread held off, when it has one.

@@ -13,6 +13,7 @@
 #include "board/sim/fault_injector.hpp"
 #include "board/sim/job_end.hpp"
 #include "board/sim/journal_replay.hpp"
+#include "board/sim/linuxcnc_wiring.hpp"
 #include "board/sim/mill_wiring.hpp"
 #include "board/sim/sim_result.hpp"
 #include "board/sim/simulated_operator.hpp"
@@ -79,7 +80,7 @@ std::function<double(double, double)> touch_tip_of(const tables::PartTables& par
 namespace {
 
 // The board's parts, handed to the runtime: the cycle reads `device`.
-runtime::JobParts parts_of(const SimJob& job, MillWiring& mill, hal::HapticDevice& device, bool realtime) {
+runtime::JobParts parts_of(const SimJob& job, SimMachine& mill, hal::HapticDevice& device, bool realtime) {
   runtime::JobParts parts;
   parts.part = job.part;
   parts.device = &device;
@@ -141,7 +142,7 @@ SimResult run_virtual(const SimJob& job, runtime::Job& assembled, MillWiring& mi
 // In real time: the hand before each cycle (unless the device runs in a process of its own, on the
 // wall clock), the job's end, and the machined part after each update; then the fake stops
 // answering, once the machine side has stopped the mill.
-SimResult run_threads(const SimJob& job, runtime::Job& assembled, MillWiring& mill, SimulatedOperator& hand,
+SimResult run_threads(const SimJob& job, runtime::Job& assembled, SimMachine& mill, SimulatedOperator& hand,
                       const runtime::PeriodicRunner& runner, SimResult& result,
                       std::chrono::steady_clock::time_point wall_start) {
   JobEnd end(job, assembled.controller());
@@ -163,12 +164,12 @@ SimResult run_threads(const SimJob& job, runtime::Job& assembled, MillWiring& mi
   return result;
 }
 
-SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
+// `cy545`: the same machine when it is the fake CY545's (virtual time needs it: its fault hooks and clock).
+SimResult run_on(const SimJob& job, const runtime::PeriodicRunner* runner, SimMachine& mill, MillWiring* cy545) {
   const bool realtime = runner != nullptr;
   const auto wall_start = std::chrono::steady_clock::now();
   SimResult result;
   result.standoff_mm = job.rig.facts.machine_standoff_mm;
-  MillWiring mill(job, realtime);
   if (!mill.error().empty()) {
     result.error = mill.error();
     return result;
@@ -197,14 +198,30 @@ SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
   if (failure != runtime::StartFailure::None) {
     result.error = failure == runtime::StartFailure::HomingNotRecorded
                        ? assembled.describe(failure)
-                       : std::string("the machine did not start: ") + mill.link().last_error();
+                       : std::string("the machine did not start: ") + mill.link_error();
     return result;
   }
   result.started = true;
   result.rss_after_setup_kb = resident_kb();
   mill.arm();
-  return realtime ? run_threads(job, assembled, mill, hand, *runner, result, wall_start)
-                  : run_virtual(job, assembled, mill, hand, replay_device, result, wall_start);
+  if (realtime) {
+    return run_threads(job, assembled, mill, hand, *runner, result, wall_start);
+  }
+  return run_virtual(job, assembled, *cy545, hand, replay_device, result, wall_start);
+}
+
+SimResult run_job(const SimJob& job, const runtime::PeriodicRunner* runner) {
+  if (job.linuxcnc && runner == nullptr) {
+    SimResult refused;
+    refused.error = "a LinuxCNC mill runs in real time only (--speed 1): LinuxCNC keeps the wall clock's time";
+    return refused;
+  }
+  if (job.linuxcnc) {
+    LinuxcncWiring mill(job);
+    return run_on(job, runner, mill, nullptr);
+  }
+  MillWiring mill(job, runner != nullptr);
+  return run_on(job, runner, mill, &mill);
 }
 
 }  // namespace

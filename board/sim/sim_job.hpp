@@ -26,6 +26,7 @@
 #include "firmware/runtime/periodic_runner.hpp"
 #include "firmware/core/tables/part_tables.hpp"
 #include "hal/clock.hpp"
+#include "hal/linuxcnc/linuxcnc_link.hpp"
 #include "sim/mill/stock_zmap.hpp"
 #include "sim/operator/operator_script.hpp"
 
@@ -35,6 +36,11 @@ namespace stencil::board::sim {
 
 // How the cycle reaches the simulated device: in process, or through the real backends' code over a
 // memfd window (the PIO card's layout) or a socketpair carrying CAN frames.
+struct LinuxcncMill {
+  hal::linuxcnc::LinuxcncConfig link;
+  std::string samples_path;
+};
+
 enum class HapticTransport : std::uint8_t { Direct, Pio, Can };
 
 struct SimJob {
@@ -69,6 +75,10 @@ struct SimJob {
   // An operator display (--hmi): fed from the records side and the machine side, never the cycle;
   // its requests go into the command ring.
   control::DisplayFeed* display = nullptr;
+  // run_realtime only: the real LinuxCNC as the mill instead of the fake CY545 and its simulated mill
+  // (sim/linuxcnc_mill runs one): the link's configuration, and the file halsampler writes every servo
+  // period's joint positions to, the ground truth of what was machined.
+  std::optional<LinuxcncMill> linuxcnc;
 };
 
 using report::Quantiles;

@@ -22,7 +22,7 @@ std::int64_t max_resident_kb() {
 
 // The cycle's and the machine side's statistics, the job's extremes and how it ended.
 void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome,
-                     const MillWiring& mill, bool realtime) {
+                     const SimMachine& mill, bool realtime) {
   const control::Controller& controller = job.controller();
   const control::MachineSide& machine = job.machine();
   result.cycles = controller.statistics().cycles;
@@ -42,7 +42,7 @@ void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::
   result.machine_max_lag_mm = machine.statistics().max_lag_mm;
   result.safe_state = controller.safe_reason();
   if (machine.fault() != hal::MachineFault::None || machine.state() == control::MachineSideState::Stopped) {
-    result.machine_error = mill.link().last_error();
+    result.machine_error = mill.link_error();
   }
   if (machine.stalled()) {
     result.machine_error = runtime::stall_message(machine.stall());
@@ -112,7 +112,7 @@ std::int64_t resident_kb() {
   return static_cast<std::int64_t>(resident) * (sysconf(_SC_PAGESIZE) / 1024);
 }
 
-void fill_result(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome, const MillWiring& mill,
+void fill_result(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome, const SimMachine& mill,
                  bool realtime, std::chrono::steady_clock::time_point wall_start) {
   result.rss_at_end_kb = resident_kb();
   result.max_rss_kb = max_resident_kb();

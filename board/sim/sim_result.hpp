@@ -6,7 +6,7 @@
 #include <chrono>
 #include <cstdint>
 
-#include "board/sim/mill_wiring.hpp"
+#include "board/sim/sim_machine.hpp"
 #include "board/sim/sim_job.hpp"
 #include "firmware/core/stencil/triangle_set.hpp"
 #include "firmware/core/tables/part_tables.hpp"
@@ -23,7 +23,7 @@ namespace stencil::board::sim {
 
 // Fills the rest of `result` (what the run's hooks reported is in it already): in real time the
 // wake-up latency is the cycle's; in virtual time there is none to speak of.
-void fill_result(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome, const MillWiring& mill,
+void fill_result(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome, const SimMachine& mill,
                  bool realtime, std::chrono::steady_clock::time_point wall_start);
 
 }  // namespace stencil::board::sim

@@ -360,6 +360,19 @@ MachineResult LinuxcncLink::home(MonotonicNs deadline_ns) {
       !check_errors(deadline_ns, false) || !read_position(deadline_ns)) {
     return {false, MachineRefusal::None, fault_};
   }
+  // Homing that stood (LinuxCNC kept it) leaves the mill where it stopped: it goes home as homing
+  // would, Z first (the tool up out of the stock, then across), at rapid.
+  const bool away = std::fabs(actual_mm_[0]) > 1e-4 || std::fabs(actual_mm_[1]) > 1e-4 || std::fabs(actual_mm_[2]) > 1e-4;
+  if (away && (!set("set mdi G53 G0 Z0", "MDI", deadline_ns) || !set("set mdi G53 G0 X0 Y0", "MDI", deadline_ns))) {
+    return {false, MachineRefusal::None, fault_};
+  }
+  if (away && !await_home(deadline_ns)) {
+    if (abort_asked()) {
+      static_cast<void>(stop(deadline_ns));
+      return refuse(MachineRefusal::Aborted);
+    }
+    return {false, MachineRefusal::None, fault_};
+  }
   for (std::size_t i = 0; i < 3; ++i) {
     const double steps = std::round(actual_mm_[i] * config_.steps_per_mm);
     if (!(std::fabs(steps) <= 2e9)) {
@@ -374,6 +387,31 @@ MachineResult LinuxcncLink::home(MonotonicNs deadline_ns) {
   homed_ = true;
   state_ = MachineState::Homed;
   return {true, MachineRefusal::None, MachineFault::None};
+}
+
+bool LinuxcncLink::await_home(MonotonicNs deadline_ns) {
+  for (;;) {
+    if (abort_asked()) {
+      return false;
+    }
+    std::string_view reply;
+    if (!check_health(deadline_ns) || !get("program_status", deadline_ns, reply)) {
+      return false;
+    }
+    if (value_of(reply, "PROGRAM_STATUS") == "IDLE") {
+      if (!read_position(deadline_ns)) {
+        return false;
+      }
+      if (std::fabs(actual_mm_[0]) <= 1e-4 && std::fabs(actual_mm_[1]) <= 1e-4 && std::fabs(actual_mm_[2]) <= 1e-4) {
+        return true;
+      }
+    }
+    if (clock_.now_ns() + config_.homing_poll_ns >= deadline_ns) {
+      static_cast<void>(fail(MachineFault::Timeout, "LinuxCNC did not get back home in time", reply));
+      return false;
+    }
+    clock_.sleep_until_ns(clock_.now_ns() + config_.homing_poll_ns);
+  }
 }
 
 MachineResult LinuxcncLink::move(const MachineTarget& target, MonotonicNs deadline_ns) {
@@ -420,23 +458,56 @@ MachineResult LinuxcncLink::verify(MonotonicNs deadline_ns) {
   if (!homed_) {
     return refuse(MachineRefusal::NotHomed);
   }
-  if (!check_health(deadline_ns) || !update_moves_done(deadline_ns) || !compare_at_rest(deadline_ns)) {
+  if (!check_health(deadline_ns) || !update_moves_done(deadline_ns) || !compare_at_rest(deadline_ns, true)) {
     return {false, MachineRefusal::None, fault_};
   }
   return {true, MachineRefusal::None, MachineFault::None};
 }
 
-bool LinuxcncLink::compare_at_rest(MonotonicNs deadline_ns) {
+bool LinuxcncLink::compare_at_rest(MonotonicNs deadline_ns, bool actual_too) {
   if (moves_done_ != moves_sent_) {
+    at_rest_short_ = 0;
     return true;  // still moving: compared once at rest
+  }
+  std::string_view reply;
+  std::array<double, 3> command_mm{};
+  if (!get("abs_cmd_pos", deadline_ns, reply)) {
+    return false;
+  }
+  if (!parse_xyz(reply, "ABS_CMD_POS", command_mm)) {
+    static_cast<void>(fail(MachineFault::GarbledReply, "linuxcncrsh's answer to \"get abs_cmd_pos\" did not parse", reply));
+    return false;
+  }
+  // LinuxCNC prints 6 decimals: a target on the step grid comes back within half a micrometre.
+  bool short_of_it = false;
+  for (std::size_t i = 0; i < 3; ++i) {
+    short_of_it = short_of_it || std::fabs(command_mm[i] - mm_of(commanded_[i])) > 0.002;
+  }
+  // IDLE and its command short of the target: stopped on the way (its external e-stop aborts the
+  // motion a moment before its status says ESTOP ON). Seen twice in a row, since IDLE can also
+  // come a moment before a new move starts (once in a hundred, measured).
+  if (short_of_it && ++at_rest_short_ >= 2) {
+    std::array<char, 220> what{};
+    std::snprintf(what.data(), what.size(), "LinuxCNC stopped with its command at %.4f %.4f %.4f mm, short of %.4f %.4f %.4f mm",
+                  command_mm[0], command_mm[1], command_mm[2], mm_of(commanded_[0]), mm_of(commanded_[1]),
+                  mm_of(commanded_[2]));
+    static_cast<void>(fail(MachineFault::PositionMismatch, what.data()));
+    return false;
+  }
+  if (short_of_it) {
+    return true;
+  }
+  at_rest_short_ = 0;
+  if (!actual_too) {
+    return true;
   }
   if (!read_position(deadline_ns)) {
     return false;
   }
   for (std::size_t i = 0; i < 3; ++i) {
     if (std::fabs(actual_mm_[i] - mm_of(commanded_[i])) > config_.position_tolerance_mm) {
-      std::array<char, 200> what{};
-      std::snprintf(what.data(), what.size(), "LinuxCNC stopped at %.4f %.4f %.4f mm, commanded %.4f %.4f %.4f mm",
+      std::array<char, 220> what{};
+      std::snprintf(what.data(), what.size(), "LinuxCNC stands at %.4f %.4f %.4f mm, commanded %.4f %.4f %.4f mm",
                     actual_mm_[0], actual_mm_[1], actual_mm_[2], mm_of(commanded_[0]), mm_of(commanded_[1]),
                     mm_of(commanded_[2]));
       static_cast<void>(fail(MachineFault::PositionMismatch, what.data()));
@@ -470,7 +541,7 @@ MachineResult LinuxcncLink::keep_alive(MonotonicNs deadline_ns) {
   // At rest it must stand where it was told. LinuxCNC's external e-stop (its HAL chain) aborts the
   // motion while linuxcncrsh still answers ESTOP OFF and MACHINE ON (LinuxCNC 2.9, measured with
   // sim/linuxcnc_mill): a mill that stopped short is how it shows.
-  if (!check_health(deadline_ns) || (homed_ && (!update_moves_done(deadline_ns) || !compare_at_rest(deadline_ns)))) {
+  if (!check_health(deadline_ns) || (homed_ && (!update_moves_done(deadline_ns) || !compare_at_rest(deadline_ns, false)))) {
     return {false, MachineRefusal::None, fault_};
   }
   return {true, MachineRefusal::None, MachineFault::None};

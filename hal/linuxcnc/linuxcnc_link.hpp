@@ -37,7 +37,8 @@ struct LinuxcncConfig {
   std::array<double, 3> travel_mm{};      // machine mm per axis from home: targets outside are refused
   double max_move_mm = 0.0;               // the longest move an update may hold, per axis (the planner's budget)
   double feed_mm_per_min = 300.0;         // F of every G1 (LinuxCNC keeps each axis within its INI limits)
-  double position_tolerance_mm = 0.002;   // verify: LinuxCNC's actual position at rest against the commanded
+  double position_tolerance_mm = 0.02;    // verify: LinuxCNC's actual position at rest against the commanded
+                                          // (its motor settles a few ms after its command, up to 17 um behind)
   MonotonicNs reply_timeout_ns = 400'000'000;   // a set's answer (about 100 ms when well)
   MonotonicNs homing_bound_ns = 60'000'000'000;  // LinuxCNC's homing sequence from anywhere
   MonotonicNs homing_poll_ns = 50'000'000;      // JOINT_HOMED asked this often while homing
@@ -99,8 +100,11 @@ class LinuxcncLink final : public MachineLink {
   bool check_health(MonotonicNs deadline_ns);
   bool read_position(MonotonicNs deadline_ns);
   bool update_moves_done(MonotonicNs deadline_ns);
-  // Once every move is done, LinuxCNC's actual position against the commanded: a difference is a fault.
-  bool compare_at_rest(MonotonicNs deadline_ns);
+  // After "G53 G0" to home: waits (polling, bounded by the deadline) until LinuxCNC stands there.
+  bool await_home(MonotonicNs deadline_ns);
+  // Once every move is done: LinuxCNC's command must be the last target (else it stopped short), and
+  // with `actual_too` its actual position within position_tolerance_mm of it.
+  bool compare_at_rest(MonotonicNs deadline_ns, bool actual_too);
   [[nodiscard]] bool abort_asked() const { return abort_ != nullptr && abort_->load(std::memory_order_relaxed); }
   [[nodiscard]] double mm_of(std::int32_t steps) const { return static_cast<double>(steps) / config_.steps_per_mm; }
 
@@ -117,6 +121,7 @@ class LinuxcncLink final : public MachineLink {
   bool machine_on_ = false;
   const std::atomic<bool>* abort_ = nullptr;
   std::uint64_t moves_sent_ = 0;
+  int at_rest_short_ = 0;  // looks in a row that found LinuxCNC idle short of its target
   std::uint64_t moves_done_ = 0;
   std::array<char, 96> command_{};    // the line being built
   std::array<char, 320> last_error_{};

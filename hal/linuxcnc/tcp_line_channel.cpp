@@ -132,8 +132,9 @@ LineStatus TcpLineChannel::read_line(std::string_view& line, MonotonicNs deadlin
     return LineStatus::Closed;
   }
   for (;;) {
-    // linuxcncrsh ends a set's answer "\n\r": the "\r" starts the next line, and is dropped there.
-    while (start_ < end_ && buffer_[start_] == '\r') {
+    // linuxcncrsh ends its lines "\r\n", a set's answer "\n\r" and a refused get's "\r\n\r\n": a
+    // line is what lies between runs of line ends, and empty ones are none.
+    while (start_ < end_ && (buffer_[start_] == '\r' || buffer_[start_] == '\n')) {
       ++start_;
     }
     // A whole line already here?

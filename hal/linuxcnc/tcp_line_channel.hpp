@@ -37,7 +37,8 @@ class TcpLineChannel {
 
   // Sends `line` and a "\r\n" (whole, or a status that says why not).
   LineStatus send_line(std::string_view line, MonotonicNs deadline_ns);
-  // The next line without its end ("\n", "\r\n"); `line` stays valid until the next call.
+  // The next non-empty line, without its end (any run of "\r" and "\n" ends a line); `line` stays
+  // valid until the next call.
   LineStatus read_line(std::string_view& line, MonotonicNs deadline_ns);
   // Drops whatever has arrived and was not read (a reply that came after its deadline).
   void discard_pending();

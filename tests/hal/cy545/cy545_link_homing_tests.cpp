@@ -4,19 +4,16 @@
 // the link to home (tests/control/machine_side_tests.cpp checks that it does, before the spindle
 // starts); the order is the link's, so it is tested here.
 #include <array>
-#include <atomic>
-#include <chrono>
+#include <algorithm>
 #include <cstdint>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "board/sherline_suzuki/rig_facts.hpp"
 #include "board/sim/sim_facts.hpp"
 #include "hal/cy545/cy545_link.hpp"
-#include "hal/posix_clock/monotonic_clock.hpp"
 #include "sim/cy545/fake_cy545.hpp"
-#include "sim/cy545/fake_cy545_runner.hpp"
+#include "sim/cy545/fake_cy545_clock.hpp"
 #include "sim/mill/simulated_mill.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -30,51 +27,39 @@ namespace {
 
 constexpr hal::MonotonicNs kMs = 1'000'000;
 
-// Homes the link on the simulated mill, every axis some way above its switch, watching the mill from
-// another thread: the axes in the order they first moved.
+// The axes in the order they first moved: the mill's own account of every step (its motion observer).
+struct FirstMoves final : sim::MillMotionObserver {
+  std::vector<int> order;
+  void axis_moved(Axis axis, const std::array<std::int64_t, sim::kMillAxisCount>& /*axis_steps*/) override {
+    const int moved = static_cast<int>(axis);
+    if (std::find(order.begin(), order.end(), moved) == order.end()) {
+      order.push_back(moved);
+    }
+  }
+};
+
+// Homes the link on the simulated mill, every axis some way above its switch, on the fake chip's
+// virtual clock (deterministic: no thread of the fake's, nothing a loaded host can starve): the axes
+// in the order they first moved.
 std::vector<int> axes_in_the_order_they_moved(const hal::cy545::Cy545Config& config) {
   sim::SimulatedMill mill{board::sim::kMillConfig};
   mill.place_axis(Axis::x, 40, StepDirection::positive);
   mill.place_axis(Axis::y, 30, StepDirection::positive);
   mill.place_axis(Axis::z, 50, StepDirection::positive);
-  sim::cy545::FakeCy545 fake{mill, board::sim::kMmc4sWiring, hal::posix_clock::monotonic_now_ns()};
-  hal::posix_clock::MonotonicClock clock;
+  FirstMoves moves;
+  mill.set_motion_observer(&moves);
+  sim::cy545::FakeCy545 fake{mill, board::sim::kMmc4sWiring, 0};
+  sim::cy545::FakeCy545Clock clock{fake, 0, board::sim::kBaud};
   hal::cy545::SerialPort port;
   char error[256] = {};
   CHECK_TEXT(port.open(fake.slave_path().c_str(), board::sim::kBaud, error), error);
   hal::cy545::Cy545Link link(port, clock, config);
-  sim::cy545::FakeCy545Runner runner{fake};
-
-  const auto positions = [&] {
-    return runner.with_fake([&](sim::cy545::FakeCy545&) {
-      return std::array<std::int64_t, 3>{mill.axis_position_steps(Axis::x), mill.axis_position_steps(Axis::y),
-                                         mill.axis_position_steps(Axis::z)};
-    });
-  };
-  const std::array<std::int64_t, 3> start = positions();
-  std::vector<int> order;
-  std::atomic<bool> homing_done{false};
-  std::thread watcher([&] {
-    std::array<bool, 3> moved{};
-    while (!homing_done.load()) {
-      const std::array<std::int64_t, 3> now = positions();
-      for (int axis = 0; axis < 3; ++axis) {
-        const auto a = static_cast<std::size_t>(axis);
-        if (!moved[a] && now[a] != start[a]) {
-          moved[a] = true;
-          order.push_back(axis);
-        }
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(200));
-    }
-  });
   const hal::MachineResult started = link.start(clock.now_ns() + 2000 * kMs);
   CHECK_TEXT(started.done, link.last_error());
   const hal::MachineResult homed = link.home(clock.now_ns() + link.homing_bound_ns() + 1000 * kMs);
-  homing_done.store(true);
-  watcher.join();
   CHECK_TEXT(homed.done, link.last_error());
-  return order;
+  mill.set_motion_observer(nullptr);
+  return moves.order;
 }
 
 hal::cy545::Cy545Config fast_homing_config() {
@@ -82,7 +67,6 @@ hal::cy545::Cy545Config fast_homing_config() {
   config.motion.homing_rate = 20000;  // quick in tests
   config.motion.homing_slow_rate = 5000;
   config.motion.homing_travel_steps = 2000;  // every axis starts within 200 steps of its switch
-  config.reply_timeout_ns = 1000 * kMs;      // a thread on a loaded host, not a chip
   return config;
 }
 

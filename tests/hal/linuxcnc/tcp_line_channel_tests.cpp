@@ -1,5 +1,5 @@
 // The TCP line channel against a listening socket the test owns on loopback: lines both ways, the
-// "\n\r" linuxcncrsh ends a set's answer with, a peer that says nothing (a timeout by the
+// "\n\r" linuxcncrsh ends a set's answer with and the empty line after a refused get, a peer that says nothing (a timeout by the
 // deadline), one that hangs up, one that sends a line longer than the buffer, and nothing listening.
 #include <arpa/inet.h>
 #include <netinet/in.h>
@@ -67,10 +67,12 @@ TEST(TcpLineChannel, LinesGoOutWithCrLfAndComeBackWithoutTheirEnds) {
   CHECK(channel.send_line("get estop", in(500 * kMs)) == LineStatus::Ok);
   STRCMP_EQUAL("get estop\r\n", read_some(peer).c_str());
   // linuxcncrsh ends a set's answer "\n\r": the "\r" must not start the next line.
-  write_all(peer, "SET MDI ACK\n\rESTOP OFF\r\nHELLO");
+  write_all(peer, "SET MDI ACK\n\rGET FOO NAK\r\n\r\nESTOP OFF\r\nHELLO");
   std::string_view line;
   CHECK(channel.read_line(line, in(500 * kMs)) == LineStatus::Ok);
   CHECK(line == "SET MDI ACK");
+  CHECK(channel.read_line(line, in(500 * kMs)) == LineStatus::Ok);
+  CHECK(line == "GET FOO NAK");  // and its extra empty line is none
   CHECK(channel.read_line(line, in(500 * kMs)) == LineStatus::Ok);
   CHECK(line == "ESTOP OFF");
   // Half a line is not a line: it waits for the rest, until the deadline.
