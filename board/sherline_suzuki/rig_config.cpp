@@ -1,5 +1,6 @@
 #include "board/sherline_suzuki/rig_config.hpp"
 
+#include <arpa/inet.h>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -26,8 +27,14 @@ struct Value {
   std::string text;
 };
 
-// One key: its type, the range of every number in it, whether the file must have it, its unit and
-// meaning, where it goes, and (when the range is not all) a check of its own: null, or what was expected.
+// Which controller a key belongs to: the CY545's keys (its serial line, step rate, backlash, switches,
+// homing and board) are left out with LinuxCNC, whose INI says those things for its mill, and
+// [machine.linuxcnc] is left out with the CY545.
+enum class Use : std::uint8_t { Any, Cy545, Linuxcnc };
+
+// One key: its type, the range of every number in it, whether the file must have it (when its
+// controller is the file's), its unit and meaning, where it goes, (when the range is not all) a check
+// of its own: null, or what was expected; and the controller it belongs to.
 struct Key {
   const char* name;
   Kind kind;
@@ -36,6 +43,7 @@ struct Key {
   const char* meaning;
   void (*apply)(RigConfig&, const Value&);
   const char* (*check)(const Value&) = nullptr;
+  Use use = Use::Any;
 };
 
 std::array<std::uint8_t, 3> bytes3(const Value& v) {
@@ -76,14 +84,43 @@ const char* device_path(const Value& v) {
 const char* distinct_channels(const Value& v) {
   return v.n[0] != v.n[1] && v.n[1] != v.n[2] && v.n[0] != v.n[2] ? nullptr : "a different channel per axis";
 }
+const char* controller_name(const Value& v) {
+  return v.text == "cy545" || v.text == "linuxcnc" ? nullptr : "\"cy545\" or \"linuxcnc\"";
+}
+const char* ipv4_digits(const Value& v) {
+  in_addr parsed{};
+  return v.text.size() < 16 && ::inet_pton(AF_INET, v.text.c_str(), &parsed) == 1
+             ? nullptr
+             : "IPv4 digits, e.g. \"127.0.0.1\" (LinuxCNC on this box)";
+}
+// linuxcncrsh copies each password into a buffer of 16 bytes (char pwd[16], with strncpy of the whole
+// argument: a longer one overruns it), and the rig sends it in a line of words ("hello PASSWORD ...").
+const char* linuxcncrsh_password(const Value& v) {
+  if (v.text == "EMC" || v.text == "EMCTOO") {
+    return "a password of the rig's own: EMC and EMCTOO are linuxcncrsh's defaults, which anyone who reaches its "
+           "port knows (it listens on every interface)";
+  }
+  bool word = !v.text.empty() && v.text.size() <= 15;
+  for (const char c : v.text) word = word && c > ' ' && c < 0x7F;
+  return word ? nullptr
+              : "one word of 1 to 15 printable ASCII characters, no spaces (linuxcncrsh keeps 15: its buffer is 16 bytes)";
+}
+const char* some_path(const Value& v) { return v.text.empty() ? "the path of LinuxCNC's INI file" : nullptr; }
+
+template <std::size_t N>
+std::array<char, N> fixed_copy(const std::string& text) {
+  std::array<char, N> out{};
+  for (std::size_t i = 0; i + 1 < N && i < text.size(); ++i) out[i] = text[i];
+  return out;
+}
 
 // clang-format off
 const Key kKeys[] = {
   // [machine]: the mill (Sherline 3-axis) and its CY545 on the MMC-4S board, over RS-232.
   {"machine.serial_port", Kind::Text, 0, 0, true, "the CY545's RS-232 port",
-   [](RigConfig& c, const Value& v) { c.serial_port = v.text; }, device_path},
+   [](RigConfig& c, const Value& v) { c.serial_port = v.text; }, device_path, Use::Cy545},
   {"machine.serial_baud", Kind::Integer, 9600, 57600, true, "baud, 8N1; the CY545 finds the rate itself",
-   [](RigConfig& c, const Value& v) { c.facts.serial_baud = static_cast<std::uint32_t>(v.n[0]); }, port_baud},
+   [](RigConfig& c, const Value& v) { c.facts.serial_baud = static_cast<std::uint32_t>(v.n[0]); }, port_baud, Use::Cy545},
   {"machine.steps_per_mm", Kind::Reals3, 1, 100000, true, "motor steps per mm, x y z",
    [](RigConfig& c, const Value& v) { c.facts.steps_per_mm = v.n[0]; }, one_resolution},
   {"machine.axis_sign", Kind::Integers3, -1, 1, true,
@@ -93,57 +130,78 @@ const Key kKeys[] = {
   {"machine.travel_mm", Kind::Reals3, 1, 2000, true, "mm of workspace per axis from the home switch's edge",
    [](RigConfig& c, const Value& v) { c.facts.workspace_mm = v.n; }},
   {"machine.backlash_mm", Kind::Reals3, 0, 5, true, "mm of play per axis, a whole number of steps",
-   [](RigConfig& c, const Value& v) { c.facts.backlash_mm = v.n; }},
+   [](RigConfig& c, const Value& v) { c.facts.backlash_mm = v.n; }, nullptr, Use::Cy545},
   {"machine.max_speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s per axis",
-   [](RigConfig& c, const Value& v) { c.facts.max_speed_mm_per_s = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.max_speed_mm_per_s = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.step_rate_steps_per_s", Kind::Integer, 1, 27000, true, "steps/s, the CY545's rate, 27000 at most",
-   [](RigConfig& c, const Value& v) { c.facts.step_rate_steps_per_s = v.n[0]; }},
-  {"machine.update_hz", Kind::Real, 1, 200, true, "machine updates per second over the serial line",
+   [](RigConfig& c, const Value& v) { c.facts.step_rate_steps_per_s = v.n[0]; }, nullptr, Use::Cy545},
+  {"machine.update_hz", Kind::Real, 1, 200, true,
+   "machine updates per second: over the CY545's serial line, or at most 9 over linuxcncrsh",
    [](RigConfig& c, const Value& v) { c.facts.machine_update_hz = v.n[0]; }},
   {"machine.home_overtravel_mm", Kind::Real, 0, 50, true, "mm from the switch's edge down to the low hard stop",
-   [](RigConfig& c, const Value& v) { c.facts.home_overtravel_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.home_overtravel_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.far_overtravel_mm", Kind::Real, 0, 50, true, "mm past the workspace up to the high hard stop",
-   [](RigConfig& c, const Value& v) { c.facts.far_overtravel_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.far_overtravel_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.home_switch_edge_mm", Kind::Real, -50, 50, true, "machine mm at which the home switch opens",
-   [](RigConfig& c, const Value& v) { c.facts.home_switch_edge_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.home_switch_edge_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.watchdog_relay_timeout_ms", Kind::Real, 50, 10000, true, "ms without a heartbeat before the relay drops",
-   [](RigConfig& c, const Value& v) { c.facts.watchdog_relay_timeout_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }},
+   [](RigConfig& c, const Value& v) { c.facts.watchdog_relay_timeout_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }, nullptr, Use::Cy545},
+  // The controller: the CY545 (above and below: cy545 only) or LinuxCNC ([machine.linuxcnc]).
+  {"machine.controller", Kind::Text, 0, 0, false,
+   "what drives the motors: \"cy545\", the default, or \"linuxcnc\" with [machine.linuxcnc]",
+   [](RigConfig& c, const Value& v) {
+     c.facts.controller = v.text == "linuxcnc" ? MachineController::Linuxcnc : MachineController::Cy545;
+   }, controller_name},
+  // [machine.linuxcnc]: LinuxCNC through linuxcncrsh (hal/linuxcnc), its axes' limits from its INI.
+  {"machine.linuxcnc.address", Kind::Text, 0, 0, false, "LinuxCNC's box, IPv4 digits; absent: 127.0.0.1",
+   [](RigConfig& c, const Value& v) { c.facts.linuxcnc.address = fixed_copy<16>(v.text); }, ipv4_digits, Use::Linuxcnc},
+  {"machine.linuxcnc.port", Kind::Integer, 1, 65535, false, "linuxcncrsh's TCP port, its --port; absent: 5007",
+   [](RigConfig& c, const Value& v) { c.facts.linuxcnc.port = static_cast<std::uint16_t>(v.n[0]); }, nullptr, Use::Linuxcnc},
+  {"machine.linuxcnc.connect_password", Kind::Text, 0, 0, true, "linuxcncrsh's --connectpw, as the INI's DISPLAY gives it",
+   [](RigConfig& c, const Value& v) { c.facts.linuxcnc.connect_password = fixed_copy<32>(v.text); }, linuxcncrsh_password,
+   Use::Linuxcnc},
+  {"machine.linuxcnc.enable_password", Kind::Text, 0, 0, true, "linuxcncrsh's --enablepw, as the INI's DISPLAY gives it",
+   [](RigConfig& c, const Value& v) { c.facts.linuxcnc.enable_password = fixed_copy<32>(v.text); }, linuxcncrsh_password,
+   Use::Linuxcnc},
+  {"machine.linuxcnc.ini", Kind::Text, 0, 0, true,
+   "LinuxCNC's INI file, read with this file; a relative path is from this file's folder",
+   [](RigConfig& c, const Value& v) { c.linuxcnc_ini.source = v.text; }, some_path, Use::Linuxcnc},
   // [machine.homing]
   {"machine.homing.order", Kind::Text, 0, 0, true, "the axes in homing order",
    [](RigConfig& c, const Value& v) {
      for (std::size_t i = 0; i < 3; ++i) c.facts.homing_order[i] = static_cast<std::uint8_t>(v.text[i] - 'x');
-   }, z_first},
+   }, z_first, Use::Cy545},
   {"machine.homing.speed_mm_per_s", Kind::Real, 0.01, 100, true, "mm/s of the approach",
-   [](RigConfig& c, const Value& v) { c.facts.homing_speed_mm_per_s = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.homing_speed_mm_per_s = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.homing.slow_speed_mm_per_s", Kind::Real, 0.001, 100, true, "mm/s of the edge-finding steps",
-   [](RigConfig& c, const Value& v) { c.facts.homing_slow_speed_mm_per_s = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.homing_slow_speed_mm_per_s = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.homing.chunk_mm", Kind::Real, 0.001, 10, true, "mm an approach may run into the switch",
-   [](RigConfig& c, const Value& v) { c.facts.homing_chunk_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.homing_chunk_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.homing.slack_mm", Kind::Real, 0, 10, true, "mm the departure may turn before the axis moves",
-   [](RigConfig& c, const Value& v) { c.facts.homing_slack_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.homing_slack_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.homing.travel_mm", Kind::Real, 1, 5000, true, "mm of the longest approach (more than the whole travel)",
-   [](RigConfig& c, const Value& v) { c.facts.homing_travel_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.homing_travel_mm = v.n[0]; }, nullptr, Use::Cy545},
   {"machine.homing.switch_zone_mm", Kind::Real, 0.1, 100, true, "mm: a switch still closed this far out is miswired",
-   [](RigConfig& c, const Value& v) { c.facts.home_switch_zone_mm = v.n[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.home_switch_zone_mm = v.n[0]; }, nullptr, Use::Cy545},
   // [machine.board]: the MMC-4S's wiring.
   {"machine.board.motor_channel", Kind::Integers3, 0, 3, true, "output-mux port of the x y z motors",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.motor_channel = bytes3(v); }, distinct_channels},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.motor_channel = bytes3(v); }, distinct_channels, Use::Cy545},
   {"machine.board.home_input", Kind::Integers3, 0, 7, true, "input-mux port of the x y z home switches",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_input = bytes3(v); }, distinct_channels},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_input = bytes3(v); }, distinct_channels, Use::Cy545},
   {"machine.board.spindle_output", Kind::Integer, 0, 7, true, "general-purpose output that runs the spindle",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.spindle_output = static_cast<std::uint8_t>(v.n[0]); }},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.spindle_output = static_cast<std::uint8_t>(v.n[0]); }, nullptr, Use::Cy545},
   {"machine.board.heartbeat_output", Kind::Integer, -1, 7, true, "output the watchdog relay watches, -1: no relay",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_output = static_cast<int>(v.n[0]); }},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_output = static_cast<int>(v.n[0]); }, nullptr, Use::Cy545},
   {"machine.board.heartbeat_period_ms", Kind::Real, 10, 5000, true, "ms per heartbeat (toggled every half)",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_period_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.heartbeat_period_ns = static_cast<hal::MonotonicNs>(v.n[0] * kNs); }, nullptr, Use::Cy545},
   {"machine.board.home_switch_closed_level", Kind::Flags3, 0, 0, true, "x y z: the level read while the switch is closed",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_switch_closed_level = v.b; }},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.home_switch_closed_level = v.b; }, nullptr, Use::Cy545},
   {"machine.board.channel_lines_latch_data", Kind::Flag, 0, 0, true, "true: each channel line latches its data bit",
-   [](RigConfig& c, const Value& v) { c.facts.mmc4s.channel_lines_latch_data = v.b[0]; }},
+   [](RigConfig& c, const Value& v) { c.facts.mmc4s.channel_lines_latch_data = v.b[0]; }, nullptr, Use::Cy545},
   {"machine.board.step_direction", Kind::Integers3, -1, 1, true,
    "x y z: +1 when the CY545's + steps move the axis away from its home switch, -1 when the direction line is wired the other way",
    [](RigConfig& c, const Value& v) { c.facts.mmc4s.step_direction = {static_cast<int>(v.n[0]), static_cast<int>(v.n[1]), static_cast<int>(v.n[2])}; },
-   unit_signs},
+   unit_signs, Use::Cy545},
   // [haptic]: the device (Suzuki 5-DOF) and the cycle.
   {"haptic.link", Kind::Text, 0, 0, true, "the device's link",
    [](RigConfig& c, const Value& v) { c.haptic_link = v.text; }, haptic_link_name},
@@ -349,7 +407,16 @@ struct Where {
   }
 };
 
-// Facts that contradict each other, or a ceiling of the hardware: "" or the message.
+std::string standoff_contradiction(const RigFacts& f, const Where& where) {
+  if (f.machine_standoff_mm < standoff_needed_mm(f)) {
+    return where("controller.standoff_mm") + "controller.standoff_mm " + number_text(f.machine_standoff_mm) +
+           " is under the " + number_text(standoff_needed_mm(f)) + " mm the planner's fallback staircase needs at " +
+           number_text(f.steps_per_mm) + " steps/mm";
+  }
+  return "";
+}
+
+// Facts that contradict each other, or a ceiling of the hardware (a CY545 rig): "" or the message.
 std::string contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
   const RigFacts& f = c.facts;
   const Where where{lines, source};
@@ -371,10 +438,9 @@ std::string contradiction(const RigConfig& c, const std::map<std::string, long>&
              static_cast<char>('x' + axis) + " is " + number_text(steps) + " steps: expected a whole number of steps";
     }
   }
-  if (f.machine_standoff_mm < standoff_needed_mm(f)) {
-    return where("controller.standoff_mm") + "controller.standoff_mm " + number_text(f.machine_standoff_mm) +
-           " is under the " + number_text(standoff_needed_mm(f)) + " mm the planner's fallback staircase needs at " +
-           number_text(f.steps_per_mm) + " steps/mm";
+  const std::string standoff = standoff_contradiction(f, where);
+  if (!standoff.empty()) {
+    return standoff;
   }
   if (!motion::follow_fallback_fits(planner_limits(f))) {
     return where("machine.update_hz") + "one machine update (machine.update_hz " + number_text(f.machine_update_hz) +
@@ -409,6 +475,13 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
              ": expected more than " + static_cast<char>('x' + axis) + "'s whole travel, " + number_text(whole) + " mm";
     }
   }
+  return "";
+}
+
+// What any rig's threads and commissioning must keep to: "" or the message.
+std::string threads_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  const RigFacts& f = c.facts;
+  const Where where{lines, source};
   if (c.machine_priority >= c.cycle_priority) {
     return where("threads.machine_priority") + "threads.machine_priority " + std::to_string(c.machine_priority) +
            ": expected below threads.cycle_priority " + std::to_string(c.cycle_priority);
@@ -420,6 +493,52 @@ std::string homing_contradiction(const RigConfig& c, const std::map<std::string,
              number_text(f.workspace_mm[axis]) + " mm)";
     }
   }
+  return "";
+}
+
+// The most updates a second over linuxcncrsh: it answers a set once LinuxCNC's task has taken it,
+// polling for that every 0.1 s, and each update sends one (a G1), so about 8 a second are kept.
+constexpr double kLinuxcncMaxUpdateHz = 9.0;
+
+// A LinuxCNC rig's facts against each other and against its INI: "" or the message.
+std::string linuxcnc_contradiction(const RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  const RigFacts& f = c.facts;
+  const Where where{lines, source};
+  if (f.machine_update_hz > kLinuxcncMaxUpdateHz) {
+    return where("machine.update_hz") + "machine.update_hz " + number_text(f.machine_update_hz) +
+           ": expected at most 9 with machine.controller = \"linuxcnc\": each update is one G1 over linuxcncrsh, which "
+           "answers a set after about 100 ms (it polls every 0.1 s), so 8 updates a second is what it keeps";
+  }
+  const std::string travel = linuxcnc_travel_outside_limits(c.linuxcnc_ini, f.workspace_mm);
+  if (!travel.empty()) {
+    return where("machine.travel_mm") + "machine.travel_mm: " + travel;
+  }
+  const std::string display = linuxcnc_display_disagreement(c.linuxcnc_ini, f.linuxcnc.port, f.linuxcnc.connect_password.data(),
+                                                            f.linuxcnc.enable_password.data());
+  if (!display.empty()) {
+    return where("machine.linuxcnc.ini") + "machine.linuxcnc.ini: " + display;
+  }
+  const motion::PlannerLimits limits = planner_limits(f);
+  const double slowest_mm = linuxcnc_shortest_update_move_mm(f);
+  const std::string axes = " mm from rest to rest in one update (1/" + number_text(f.machine_update_hz) +
+                           " s) on its slowest axis, as the INI's MAX_VELOCITY and MAX_ACCELERATION allow";
+  if (f.virtual_tool_speed_mm_per_s > limits.speed.max_axis_speed_mm_per_s) {
+    return where("controller.virtual_tool_speed_mm_per_s") + "controller.virtual_tool_speed_mm_per_s " +
+           number_text(f.virtual_tool_speed_mm_per_s) + " is above the " +
+           number_text(limits.speed.max_axis_speed_mm_per_s) + " mm/s the LinuxCNC mill makes good (" +
+           number_text(slowest_mm) + axes + "): the mill could not follow the tool";
+  }
+  const std::string standoff = standoff_contradiction(f, where);
+  if (!standoff.empty()) {
+    return standoff;
+  }
+  if (!motion::follow_fallback_fits(limits)) {
+    return where("machine.update_hz") + "one machine update (machine.update_hz " + number_text(f.machine_update_hz) +
+           ") is too short for the planner's fallback move at " + number_text(f.steps_per_mm) +
+           " steps/mm: the LinuxCNC mill goes " + number_text(slowest_mm) + axes;
+  }
+  // What the link checks again as it starts (hal::linuxcnc::check_linuxcnc_config) is covered by the
+  // keys' own checks above: its tests hold the two together (rig_config_tests).
   return "";
 }
 
@@ -447,6 +566,68 @@ std::string wiring_contradiction(const RigConfig& c, const std::map<std::string,
   return "";
 }
 
+bool belongs(const Key& key, MachineController controller) {
+  return key.use == Use::Any || (key.use == Use::Cy545) == (controller == MachineController::Cy545);
+}
+
+const char* controller_text(MachineController controller) {
+  return controller == MachineController::Linuxcnc ? "\"linuxcnc\"" : "\"cy545\"";
+}
+
+// A section or key of the other controller's (an empty section counts): "" or the message.
+std::string misplaced(const toml::table& root, const RigConfig& c, const std::map<std::string, long>& lines,
+                      const std::string& source) {
+  const MachineController controller = c.facts.controller;
+  const bool linuxcnc = controller == MachineController::Linuxcnc;
+  const std::string chosen = std::string("machine.controller is ") + controller_text(controller) +
+                             (lines.count("machine.controller") == 0 ? " (absent: the CY545)" : "");
+  using Sections = std::array<const char*, 2>;
+  for (const char* section : linuxcnc ? Sections{"machine.homing", "machine.board"} : Sections{"machine.linuxcnc", nullptr}) {
+    const toml::node* node = section == nullptr ? nullptr : root.at_path(section).node();
+    if (node != nullptr) {
+      const std::string where =
+          node->source().begin.line > 0 ? at(source, static_cast<long>(node->source().begin.line)) : source + ": ";
+      return where + "[" + section + "]: " + chosen + ": expected no [" + section + "] section" +
+             (linuxcnc ? " (the CY545's: LinuxCNC's INI and HAL files say this for its mill)"
+                       : " (set machine.controller = \"linuxcnc\" to drive the mill through LinuxCNC)");
+    }
+  }
+  for (const Key& key : kKeys) {
+    const auto found = lines.find(key.name);
+    if (found != lines.end() && !belongs(key, controller)) {
+      return at(source, found->second) + key.name + ": " + chosen + ": expected no " + key.name +
+             (linuxcnc ? " (the CY545's: LinuxCNC's INI holds what its mill needs)" : " (LinuxCNC's only)");
+    }
+  }
+  return "";
+}
+
+// machine.linuxcnc.ini as a path: as given when absolute, else from the folder of `source` (the
+// configuration file's path; with no folder in it, the current one).
+std::string ini_path(const std::string& ini, const std::string& source) {
+  const std::size_t slash = source.rfind('/');
+  if (ini.empty() || ini[0] == '/' || slash == std::string::npos) {
+    return ini;
+  }
+  return source.substr(0, slash + 1) + ini;
+}
+
+// LinuxCNC's INI read into the configuration's facts: "" or the message (the INI's own, after the key).
+std::string take_linuxcnc_ini(RigConfig& c, const std::map<std::string, long>& lines, const std::string& source) {
+  LinuxcncIni ini;
+  std::string error;
+  if (!read_linuxcnc_ini(ini_path(c.linuxcnc_ini.source, source), ini, error)) {
+    return Where{lines, source}("machine.linuxcnc.ini") + "machine.linuxcnc.ini: " + error;
+  }
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    c.facts.linuxcnc.max_velocity_mm_per_s[axis] = ini.axes[axis].max_velocity_mm_per_s.value;
+    c.facts.linuxcnc.max_acceleration_mm_per_s2[axis] = ini.axes[axis].max_acceleration_mm_per_s2.value;
+  }
+  c.facts.linuxcnc.max_linear_velocity_mm_per_s = ini.max_linear_velocity_mm_per_s.value;
+  c.linuxcnc_ini = std::move(ini);
+  return "";
+}
+
 }  // namespace
 
 bool parse_rig_config(std::string_view text, const std::string& source, RigConfig& config, std::string& error) {
@@ -470,24 +651,47 @@ bool parse_rig_config(std::string_view text, const std::string& source, RigConfi
     return false;
   }
   RigConfig read = config;
+  // The controller and LinuxCNC's facts are the file's alone: absent keys take the defaults, not
+  // whatever `config` held (the CY545 and no LinuxCNC; "127.0.0.1" and 5007).
+  read.facts.controller = kRig.controller;
+  read.facts.linuxcnc = kRig.linuxcnc;
+  read.linuxcnc_ini = LinuxcncIni{};
   Reading reading{source, read, {}, {}};
   if (!read_table(parsed.table(), "", reading)) {
     error = reading.error;
     return false;
   }
+  const MachineController controller = read.facts.controller;
+  error = misplaced(parsed.table(), read, reading.lines, source);
+  if (!error.empty()) {
+    return false;
+  }
   for (const Key& key : kKeys) {
-    if (key.required && reading.lines.count(key.name) == 0) {
+    if (key.required && belongs(key, controller) && reading.lines.count(key.name) == 0) {
       error = where_missing(parsed.table(), key.name, source) + "missing the key '" + key.name + "': expected " +
-              expected_of(key);
+              expected_of(key) + (key.use == Use::Linuxcnc ? " (machine.controller is \"linuxcnc\")" : "");
       return false;
     }
   }
-  error = contradiction(read, reading.lines, source);
-  if (error.empty()) {
-    error = homing_contradiction(read, reading.lines, source);
-  }
-  if (error.empty()) {
-    error = wiring_contradiction(read, reading.lines, source);
+  if (controller == MachineController::Linuxcnc) {
+    error = take_linuxcnc_ini(read, reading.lines, source);
+    if (error.empty()) {
+      error = linuxcnc_contradiction(read, reading.lines, source);
+    }
+    if (error.empty()) {
+      error = threads_contradiction(read, reading.lines, source);
+    }
+  } else {
+    error = contradiction(read, reading.lines, source);
+    if (error.empty()) {
+      error = homing_contradiction(read, reading.lines, source);
+    }
+    if (error.empty()) {
+      error = threads_contradiction(read, reading.lines, source);
+    }
+    if (error.empty()) {
+      error = wiring_contradiction(read, reading.lines, source);
+    }
   }
   if (!error.empty()) {
     return false;
@@ -572,13 +776,21 @@ bool read_rig_config(const std::string& path, RigConfig& config, std::string& er
   config = read;
   config.file_crc32 = static_cast<std::uint32_t>(
       ::crc32(::crc32(0L, Z_NULL, 0), reinterpret_cast<const Bytef*>(text.data()), static_cast<uInt>(text.size())));
+  if (config.facts.controller == MachineController::Linuxcnc) {
+    // The file followed by its INI: a job resumes only under the same two.
+    config.file_crc32 = static_cast<std::uint32_t>(::crc32_combine(config.file_crc32, config.linuxcnc_ini.crc32,
+                                                                   static_cast<z_off_t>(config.linuxcnc_ini.size)));
+  }
   return true;
 }
 
 std::string describe_rig_config_keys() {
   std::string text;
   for (const Key& key : kKeys) {
-    text += std::string(key.name) + (key.required ? "" : " (optional)") + ": " + expected_of(key) + "\n";
+    const char* use = key.use == Use::Cy545 ? "cy545 only" : key.use == Use::Linuxcnc ? "linuxcnc only" : "";
+    const std::string optional = key.required ? "" : "optional";
+    const std::string marks = optional + (optional.empty() || *use == '\0' ? "" : ", ") + use;
+    text += std::string(key.name) + (marks.empty() ? "" : " (" + marks + ")") + ": " + expected_of(key) + "\n";
   }
   return text;
 }

@@ -11,25 +11,62 @@
 #include "hal/clock.hpp"
 #include "hal/cy545/cy545_link.hpp"
 #include "hal/haptic_device.hpp"
+#include "hal/linuxcnc/linuxcnc_link.hpp"
 
 namespace stencil::board::sherline_suzuki {
+
+// What drives the mill's motors.
+enum class MachineController : std::uint8_t {
+  Cy545,     // the CY545 on the MMC-4S board over RS-232 (hal/cy545): the thesis's rig, 30 updates a second
+  Linuxcnc,  // LinuxCNC through linuxcncrsh over TCP (hal/linuxcnc): one G1 an update, about 8 a second
+};
+
+// A mill driven by LinuxCNC: how to reach linuxcncrsh, and each axis's limits as LinuxCNC's INI gives
+// them (its [AXIS_X|Y|Z] and [TRAJ] sections, read when the configuration is loaded: linuxcnc_ini.hpp).
+// LinuxCNC plans and paces every move itself within these; planner_limits() spends them.
+struct LinuxcncFacts {
+  std::array<char, 16> address;                       // IPv4 digits, NUL-terminated
+  std::uint16_t port;                                 // linuxcncrsh --port
+  std::array<char, 32> connect_password;              // linuxcncrsh --connectpw, NUL-terminated (at most 15)
+  std::array<char, 32> enable_password;               // linuxcncrsh --enablepw
+  std::array<double, 3> max_velocity_mm_per_s;        // [AXIS_X|Y|Z] MAX_VELOCITY
+  std::array<double, 3> max_acceleration_mm_per_s2;   // [AXIS_X|Y|Z] MAX_ACCELERATION
+  double max_linear_velocity_mm_per_s;                // [TRAJ] MAX_LINEAR_VELOCITY; 0: the INI gives none
+
+  bool operator==(const LinuxcncFacts&) const = default;
+};
+
+// A NUL-terminated fixed array from a literal (constexpr: the compiled-in facts hold text this way).
+template <std::size_t N>
+constexpr std::array<char, N> fixed_text(const char* text) {
+  std::array<char, N> out{};
+  for (std::size_t i = 0; i + 1 < N && text[i] != '\0'; ++i) {
+    out[i] = text[i];
+  }
+  return out;
+}
 
 // Every per-axis array is x y z. Machine coordinates per axis: 0 at the home switch's edge, + along
 // the machine's + axis (X and Y: the table's own displacement, Z: the head's), workspace [0, workspace_mm].
 struct RigFacts {
-  // ---- The mill (Sherline 3-axis) and its motion controller (CY545 on an MMC-4S board, RS-232).
+  // ---- The mill (Sherline 3-axis) and its motion controller (CY545 on an MMC-4S board, RS-232; or LinuxCNC).
+  // The facts marked (cy545) are the CY545's and its board's: a LinuxCNC mill leaves them at the
+  // compiled-in values, which nothing on its path reads (LinuxCNC's own come from `linuxcnc`).
+  MachineController controller;
+  LinuxcncFacts linuxcnc;                   // (linuxcnc) the compiled-in rig has none: "127.0.0.1", 5007, no passwords
   std::array<double, 3> workspace_mm;       // machine workspace: the box [0,X]x[0,Y]x[0,Z]
   // World to machine, per axis: +1 counts along the world axis, -1 against it. X and Y move the table
   // (the work moves under the tool) and every axis counts into the workspace from its switch: all -1.
   std::array<int, 3> machine_sign;
   double steps_per_mm;                      // motor resolution, every axis (16000 steps/inch)
-  double max_speed_mm_per_s;                // per axis
-  double step_rate_steps_per_s;             // the CY545's R and F: all axes together, one at a time
-  std::array<double, 3> backlash_mm;
-  double machine_update_hz;                 // the CY545 link's updates
-  std::uint32_t serial_baud;                // the CY545's RS-232 line, 8N1
+  double max_speed_mm_per_s;                // per axis (cy545)
+  double step_rate_steps_per_s;             // the CY545's R and F: all axes together, one at a time (cy545)
+  std::array<double, 3> backlash_mm;        // (cy545; LinuxCNC compensates its own)
+  double machine_update_hz;                 // the machine link's updates (at most 9 with LinuxCNC)
+  std::uint32_t serial_baud;                // the CY545's RS-232 line, 8N1 (cy545)
   // How far each axis can travel past the workspace: below 0 is the home switch's closed zone down to
-  // the low hard stop, above the workspace a margin up to the high hard stop.
+  // the low hard stop, above the workspace a margin up to the high hard stop. From here to
+  // watchdog_relay_timeout_ns: (cy545), the switches, the MMC-4S and the CY545 driver's homing.
   double home_overtravel_mm;
   double far_overtravel_mm;
   double home_switch_edge_mm;               // the switch is closed below this machine coordinate, open at and above
@@ -74,6 +111,14 @@ struct RigFacts {
 };
 
 inline constexpr RigFacts kRig{
+    .controller = MachineController::Cy545,
+    .linuxcnc = {.address = fixed_text<16>("127.0.0.1"),
+                 .port = 5007,
+                 .connect_password = {},
+                 .enable_password = {},
+                 .max_velocity_mm_per_s = {},
+                 .max_acceleration_mm_per_s2 = {},
+                 .max_linear_velocity_mm_per_s = 0.0},
     .workspace_mm = {50.0, 25.0, 25.0},
     .machine_sign = {-1, -1, -1},
     .steps_per_mm = 640.0,
@@ -167,12 +212,59 @@ inline constexpr long long backlash_steps(int axis, const RigFacts& facts = kRig
 static_assert(backlash_steps(0) == 80 && backlash_steps(1) == 32 && backlash_steps(2) == 80,
               "backlash must be a whole number of steps");
 
+// ---- A LinuxCNC mill's budget. Each update is one G1 in exact-path mode (G61): LinuxCNC starts it
+// from rest and brings the axes to rest at its end, so an axis with top speed v (mm/s) and
+// acceleration a (mm/s^2) covers at most, in one update of T seconds,
+//   d(T) = a T^2 / 4        when T <= 2 v / a (it never reaches v: accelerate half the time, brake half),
+//   d(T) = v (T - v / a)    otherwise (accelerate for v / a, cruise, brake for v / a).
+// Both give v^2 / a at T = 2 v / a. v is the axis's MAX_VELOCITY, under [TRAJ] MAX_LINEAR_VELOCITY
+// when the INI gives one (no axis moves faster than the path); a is its MAX_ACCELERATION.
+inline constexpr double rest_to_rest_mm(double period_s, double max_velocity_mm_per_s, double max_acceleration_mm_per_s2) {
+  const double v = max_velocity_mm_per_s;
+  const double a = max_acceleration_mm_per_s2;
+  return period_s <= 2.0 * v / a ? a * period_s * period_s / 4.0 : v * (period_s - v / a);
+}
+inline constexpr double linuxcnc_axis_velocity_mm_per_s(int axis, const RigFacts& facts) {
+  const double v = facts.linuxcnc.max_velocity_mm_per_s[static_cast<std::size_t>(axis)];
+  const double path = facts.linuxcnc.max_linear_velocity_mm_per_s;
+  return path > 0.0 && path < v ? path : v;
+}
+// How far `axis` can go in one machine update, from rest to rest (mm).
+inline constexpr double linuxcnc_update_move_mm(int axis, const RigFacts& facts) {
+  return rest_to_rest_mm(1.0 / facts.machine_update_hz, linuxcnc_axis_velocity_mm_per_s(axis, facts),
+                         facts.linuxcnc.max_acceleration_mm_per_s2[static_cast<std::size_t>(axis)]);
+}
+inline constexpr double linuxcnc_shortest_update_move_mm(const RigFacts& facts) {
+  double shortest = linuxcnc_update_move_mm(0, facts);
+  for (int axis = 1; axis < 3; ++axis) {
+    shortest = linuxcnc_update_move_mm(axis, facts) < shortest ? linuxcnc_update_move_mm(axis, facts) : shortest;
+  }
+  return shortest;
+}
+inline constexpr double linuxcnc_longest_update_move_mm(const RigFacts& facts) {
+  double longest = linuxcnc_update_move_mm(0, facts);
+  for (int axis = 1; axis < 3; ++axis) {
+    longest = linuxcnc_update_move_mm(axis, facts) > longest ? linuxcnc_update_move_mm(axis, facts) : longest;
+  }
+  return longest;
+}
+
 // What the machine side's planner may spend: the mill's speed, one update, the backlash to take up.
+// The CY545 steps one axis at a time: its speed per axis, its step rate for all of them, its backlash.
+// LinuxCNC moves in one coordinated straight segment (MachinePath::Straight) and takes up its own
+// backlash: every axis may move the shortest d(T) of the three in an update (as a speed, d(T) / T),
+// and the axes' sum is not limited (three times that).
 inline constexpr motion::PlannerLimits planner_limits(const RigFacts& facts) {
+  const double update_s = 1.0 / facts.machine_update_hz;
+  if (facts.controller == MachineController::Linuxcnc) {
+    const double speed = linuxcnc_shortest_update_move_mm(facts) / update_s;
+    return {{speed, 3.0 * speed * facts.steps_per_mm, facts.steps_per_mm}, update_s, {0, 0, 0}, motion::MachinePath::Straight};
+  }
   return {{facts.max_speed_mm_per_s, facts.step_rate_steps_per_s, facts.steps_per_mm},
-          1.0 / facts.machine_update_hz,
+          update_s,
           {static_cast<std::int32_t>(backlash_steps(0, facts)), static_cast<std::int32_t>(backlash_steps(1, facts)),
-           static_cast<std::int32_t>(backlash_steps(2, facts))}};
+           static_cast<std::int32_t>(backlash_steps(2, facts))},
+          motion::MachinePath::Staircase};
 }
 inline constexpr motion::PlannerLimits kPlannerLimits = planner_limits(kRig);
 
@@ -209,6 +301,28 @@ static_assert(kCy545Motion.homing_rate == 800 && kCy545Motion.homing_slow_rate =
 static_assert(kRig.homing_speed_mm_per_s < kRig.max_speed_mm_per_s && kRig.homing_slack_mm > largest_backlash_mm() &&
               kRig.home_switch_zone_mm > kRig.home_overtravel_mm);
 inline constexpr hal::cy545::Cy545Config kCy545 = cy545_config(kRig);
+
+// The LinuxCNC link's configuration on a rig: where linuxcncrsh listens and its passwords, the
+// planner's grid (machine.steps_per_mm: step n is LinuxCNC's machine n / steps_per_mm mm), the
+// workspace as its travel, the longest move an update may hold (the fastest axis's d(T) plus the
+// step of rounding the planner keeps room for) and the feed of every G1 (the fastest axis's
+// MAX_VELOCITY: LinuxCNC holds each axis to its own limits under it).
+inline constexpr hal::linuxcnc::LinuxcncConfig linuxcnc_config(const RigFacts& facts) {
+  hal::linuxcnc::LinuxcncConfig config{};
+  config.address = facts.linuxcnc.address;
+  config.port = facts.linuxcnc.port;
+  config.connect_password = facts.linuxcnc.connect_password;
+  config.enable_password = facts.linuxcnc.enable_password;
+  config.steps_per_mm = facts.steps_per_mm;
+  config.travel_mm = facts.workspace_mm;
+  config.max_move_mm = linuxcnc_longest_update_move_mm(facts) + 1.0 / facts.steps_per_mm;
+  double fastest = 0.0;
+  for (const double velocity : facts.linuxcnc.max_velocity_mm_per_s) {
+    fastest = velocity > fastest ? velocity : fastest;
+  }
+  config.feed_mm_per_min = 60.0 * fastest;
+  return config;
+}
 
 // What the haptic backends accept from this device: its reach plus the margin per side around
 // `centre_mm`, the two angles, the force and torque limits.
