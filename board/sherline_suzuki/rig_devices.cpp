@@ -51,7 +51,8 @@ bool is_haptic_link_name(const std::string& haptic) {
 bool open_rig_devices(const RigFacts& facts, const std::string& serial_path, const std::string& haptic,
                       RigDevices& devices, const std::function<void(const std::string&)>& note, std::string& error) {
   char port_error[256] = {};
-  if (!devices.port.open(serial_path.c_str(), facts.serial_baud, port_error)) {
+  const bool linuxcnc = facts.controller == MachineController::Linuxcnc;
+  if (!linuxcnc && !devices.port.open(serial_path.c_str(), facts.serial_baud, port_error)) {
     error = std::string("the mill's CY545: ") + port_error;
     return false;
   }
@@ -61,11 +62,20 @@ bool open_rig_devices(const RigFacts& facts, const std::string& serial_path, con
   if (!opened) {
     return false;
   }
+  if (linuxcnc) {
+    devices.linuxcnc = std::make_unique<hal::linuxcnc::LinuxcncLink>(devices.clock, linuxcnc_config(facts));
+    return true;
+  }
   devices.link = std::make_unique<hal::cy545::Cy545Link>(devices.port, devices.clock, cy545_config(facts));
   return true;
 }
 
 bool open_rig_machine(const RigFacts& facts, const std::string& serial_path, RigDevices& devices, std::string& error) {
+  if (facts.controller == MachineController::Linuxcnc) {
+    error = "commissioning measures the CY545 rig's axes against a dial indicator; a LinuxCNC mill's steps per mm and "
+            "backlash are set and checked in its own INI (machine.controller is \"linuxcnc\")";
+    return false;
+  }
   char port_error[256] = {};
   if (!devices.port.open(serial_path.c_str(), facts.serial_baud, port_error)) {
     error = std::string("the mill's CY545: ") + port_error;

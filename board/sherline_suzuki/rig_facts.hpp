@@ -305,8 +305,9 @@ inline constexpr hal::cy545::Cy545Config kCy545 = cy545_config(kRig);
 // The LinuxCNC link's configuration on a rig: where linuxcncrsh listens and its passwords, the
 // planner's grid (machine.steps_per_mm: step n is LinuxCNC's machine n / steps_per_mm mm), the
 // workspace as its travel, the longest move an update may hold (the fastest axis's d(T) plus the
-// step of rounding the planner keeps room for) and the feed of every G1 (the fastest axis's
-// MAX_VELOCITY: LinuxCNC holds each axis to its own limits under it).
+// step of rounding the planner keeps room for) and the feed of every G1: a path speed, so sqrt(3)
+// times the fastest axis's MAX_VELOCITY, that a diagonal move runs its axes as fast as a move along
+// one (LinuxCNC holds each axis to its own limits under it; the budget assumed each axis's own).
 inline constexpr hal::linuxcnc::LinuxcncConfig linuxcnc_config(const RigFacts& facts) {
   hal::linuxcnc::LinuxcncConfig config{};
   config.address = facts.linuxcnc.address;
@@ -320,7 +321,7 @@ inline constexpr hal::linuxcnc::LinuxcncConfig linuxcnc_config(const RigFacts& f
   for (const double velocity : facts.linuxcnc.max_velocity_mm_per_s) {
     fastest = velocity > fastest ? velocity : fastest;
   }
-  config.feed_mm_per_min = 60.0 * fastest;
+  config.feed_mm_per_min = 60.0 * 1.7320508075688772 * fastest;
   return config;
 }
 

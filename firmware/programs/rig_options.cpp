@@ -182,8 +182,11 @@ bool apply_rig_config(const CLI::App& app, RigOptions& o, std::string& error) {
   o.machine_priority = file ? std::min(c.machine_priority, o.priority - 1) : std::max(1, o.priority - 10);
   if (o.tables_path.empty() && !o.commission) {
     error = "--tables: the part's .stbl is required";
-  } else if (o.serial_path.empty()) {
+  } else if (o.serial_path.empty() && o.config.facts.controller != board::sherline_suzuki::MachineController::Linuxcnc) {
     error = "--serial: the CY545's serial port is required (or machine.serial_port in the --config file)";
+  } else if (!o.serial_path.empty() && o.config.facts.controller == board::sherline_suzuki::MachineController::Linuxcnc) {
+    error = "--serial: the --config file's mill is LinuxCNC (machine.controller = \"linuxcnc\"), reached over linuxcncrsh, "
+            "not a serial port";
   } else if (o.haptic.empty() && !o.commission) {
     error = "--haptic: the haptic link is required (or haptic.link in the --config file)";
   }

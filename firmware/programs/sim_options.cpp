@@ -112,6 +112,10 @@ void add_sim_options(CLI::App& app, SimOptions& options) {
                  "a rig's configuration file (TOML, as stencil-rig --config; every key: board/sherline_suzuki/rig.toml): "
                  "the simulation runs a copy of that rig, its mill as the file says unless --mill-truth "
                  "(default: the compiled-in Sherline/Suzuki rig)");
+  app.add_option("--linuxcnc-samples", options.linuxcnc_samples_path,
+                 "with a --config whose machine.controller is \"linuxcnc\" (the real LinuxCNC as the mill, --speed 1 "
+                 "only): halsampler's file of every servo period's joint positions (sim/linuxcnc_mill/linuxcnc-sim.sh "
+                 "start DIR writes DIR/samples.txt), the ground truth of what was machined");
   app.add_option("--mill-truth", options.mill_truth_path,
                  "a second configuration file: the simulated mill as it really is (its axis signs, steps per mm, "
                  "backlash, travel, wiring), where it differs from what --config tells the controller");
@@ -169,6 +173,31 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
   return error.empty();
 }
 
+namespace {
+
+// The real LinuxCNC as the mill: real time only, its samples the ground truth, and none of what needs
+// the simulated mill (its truth, injected faults, resuming or replaying its journal, commissioning).
+bool apply_linuxcnc(const CLI::App& app, SimOptions& o, const board::sherline_suzuki::RigConfig& config, std::string& error) {
+  if (o.speed != 1.0 || o.fast) {
+    error = "--config " + o.config_path + ": a LinuxCNC mill (machine.controller = \"linuxcnc\") runs in real time: pass --speed 1";
+  } else if (o.linuxcnc_samples_path.empty()) {
+    error = "--config " + o.config_path +
+            ": a LinuxCNC mill needs --linuxcnc-samples FILE, halsampler's file of its joint positions (the ground truth)";
+  } else if (!o.mill_truth_path.empty() || !o.inject_text.empty() || !o.resume_path.empty() || !o.replay_path.empty() ||
+             o.commission || app.count("--device-process") > 0) {
+    error = "--config " + o.config_path +
+            ": with a LinuxCNC mill there is no simulated mill: no --mill-truth, --inject, --resume, --replay, "
+            "--commission or --device-process";
+  }
+  if (!error.empty()) {
+    return false;
+  }
+  o.linuxcnc = board::sim::LinuxcncMill{board::sherline_suzuki::linuxcnc_config(config.facts), o.linuxcnc_samples_path};
+  return true;
+}
+
+}  // namespace
+
 bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
   board::sherline_suzuki::RigConfig config;
   if (!o.config_path.empty()) {
@@ -184,6 +213,13 @@ bool apply_sim_config(const CLI::App& app, SimOptions& o, std::string& error) {
     take_configured_retention(app, o.jobs, config.keep_jobs, config.keep_mb);
     if (app.count("--priority") == 0) o.priority = config.cycle_priority;
     if (app.count("--cpu") == 0) o.cpu = config.cycle_cpu;
+    if (config.facts.controller == board::sherline_suzuki::MachineController::Linuxcnc) {
+      return apply_linuxcnc(app, o, config, error);
+    }
+  }
+  if (!o.linuxcnc_samples_path.empty()) {
+    error = "--linuxcnc-samples: only with a --config whose machine.controller is \"linuxcnc\"";
+    return false;
   }
   if (!o.mill_truth_path.empty()) {
     board::sherline_suzuki::RigConfig truth;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -10,6 +11,7 @@
 #include "board/sherline_suzuki/commissioning.hpp"
 #include "board/sim/fault_injection.hpp"
 #include "board/sim/sim_facts.hpp"
+#include "board/sim/sim_job.hpp"
 #include "firmware/programs/display_option.hpp"
 #include "firmware/programs/job_folder_option.hpp"
 
@@ -18,6 +20,8 @@ namespace stencil::app {
 struct SimOptions {
   std::string config_path;      // --config: the rig's configuration file (empty: the compiled-in rig)
   std::string mill_truth_path;  // --mill-truth: the simulated mill as it really is (empty: as configured)
+  std::string linuxcnc_samples_path;  // --linuxcnc-samples: halsampler's file, with a LinuxCNC --config
+  std::optional<board::sim::LinuxcncMill> linuxcnc;  // a --config whose machine.controller is "linuxcnc"
   board::sim::SimRig rig;       // both, read by apply_sim_config
   bool commission = false;      // --commission: commissioning on the simulated rig instead of a job
   board::sherline_suzuki::CommissioningSettings commissioning;  // the file's [commissioning]

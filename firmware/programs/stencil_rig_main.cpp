@@ -213,7 +213,7 @@ void print_summary(const RigResult& result) {
 }
 
 // After the run: what it did, said at the terminal and in the report. The program's exit status.
-int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::Cy545Link& link, bool journal_closed,
+int finish(const app::RigOptions& o, const RigResult& result, const char* link_error, bool journal_closed,
            const journal::JournalWriter& journal_writer) {
   print_summary(result);
   if (!result.error.empty()) {
@@ -221,13 +221,13 @@ int finish(const app::RigOptions& o, const RigResult& result, const hal::cy545::
   }
   if (!result.machine_stop_confirmed) {
     std::fprintf(stderr, "stencil-rig: WARNING: the mill's spindle and drivers could not be confirmed off (%s): switch the "
-                 "mill's power off\n", link.last_error());
+                 "mill's power off\n", link_error);
   }
   if (!journal_closed) {
     std::fprintf(stderr, "stencil-rig: %s\n", journal_writer.error().c_str());
   }
   std::string error;
-  const std::string machine_error = result.machine_stall.empty() ? std::string(link.last_error()) : result.machine_stall;
+  const std::string machine_error = result.machine_stall.empty() ? std::string(link_error) : result.machine_stall;
   if (!result.machine_stall.empty()) {
     std::fprintf(stderr, "stencil-rig: %s\n", result.machine_stall.c_str());
   }
@@ -360,7 +360,7 @@ int main(int argc, char** argv) {
   job.display = display.feed();
   job.part = &part;
   job.device = devices.device;
-  job.machine = devices.link.get();
+  job.machine = &devices.machine();
   job.machine_clock = &devices.clock;
   job.journal = journal_writer.is_open() ? &journal_writer : nullptr;
   job.resume_from = o.resume_path;
@@ -386,8 +386,8 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "stencil-rig: %s: could not be cut back to the job it held\n", o.resume_path.c_str());
     }
     folder.abandon();
-    const std::string link_error = devices.link->last_error();
+    const std::string link_error = devices.machine_error();
     return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));
   }
-  return finish(o, result, *devices.link, journal_closed, journal_writer);
+  return finish(o, result, devices.machine_error(), journal_closed, journal_writer);
 }

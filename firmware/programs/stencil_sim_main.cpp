@@ -246,6 +246,7 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
               std::string& error) {
   job.part = &part;
   job.rig = o.rig;
+  job.linuxcnc = o.linuxcnc;
   job.stock = board::sim::default_stock(part);
   if (!o.stock_text.empty() && !parse_stock(o.stock_text, part, job.stock, error)) {
     return false;

@@ -33,9 +33,11 @@ std::string_view check_linuxcnc_config(const LinuxcncConfig& config) {
     return "linuxcncrsh's default passwords (EMC, EMCTOO) are refused: linuxcncrsh listens on every network interface, "
            "so give it passwords of its own (--connectpw, --enablepw in LinuxCNC's INI) and set them here";
   }
-  if (connect.size() >= config.connect_password.size() - 1 || enable.size() >= config.enable_password.size() - 1 ||
+  // linuxcncrsh keeps at most 15 characters of a password (sim/linuxcnc_mill/README.md): a longer
+  // one would never match what it keeps.
+  if (connect.size() > kMaxPasswordLength || enable.size() > kMaxPasswordLength ||
       connect.find_first_of(" \t\r\n") != std::string_view::npos || enable.find_first_of(" \t\r\n") != std::string_view::npos) {
-    return "a linuxcncrsh password must be one word (no spaces), at most 30 characters";
+    return "a linuxcncrsh password must be one word (no spaces), at most 15 characters (linuxcncrsh's own limit)";
   }
   in_addr parsed{};
   if (::strnlen(config.address.data(), config.address.size()) == config.address.size() ||
@@ -162,7 +164,7 @@ bool LinuxcncLink::check_errors(MonotonicNs deadline_ns, bool drop) {
     }
     // "Note: ..." is LinuxCNC telling, not failing ("Note: Motion enabled after reaching a coordinate
     // soft limit with active external offsets" comes with every machine on after an off).
-    if (!drop && !words.starts_with("Note: ")) {
+    if (!drop && !(words.size() >= 6 && std::memcmp(words.data(), "Note: ", 6) == 0)) {
       static_cast<void>(fail(MachineFault::ControllerError, "LinuxCNC reported an error", words));
       return false;
     }

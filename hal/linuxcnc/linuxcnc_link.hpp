@@ -27,6 +27,7 @@ namespace stencil::hal::linuxcnc {
 // linuxcncrsh listens on every interface.
 inline constexpr std::string_view kDefaultConnectPassword = "EMC";
 inline constexpr std::string_view kDefaultEnablePassword = "EMCTOO";
+inline constexpr std::size_t kMaxPasswordLength = 15;  // linuxcncrsh's buffers
 
 struct LinuxcncConfig {
   std::array<char, 16> address{};         // IPv4 digits, NUL-terminated ("127.0.0.1")

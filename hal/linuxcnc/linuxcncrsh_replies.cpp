@@ -108,11 +108,10 @@ bool parse_joints_homed(std::string_view line, std::array<bool, 3>& homed) {
 }
 
 ErrorReply parse_error(std::string_view line, std::string_view& text) {
-  if (!line.starts_with("ERROR ")) {
+  std::string_view words = line;
+  if (next_word(words) != "ERROR" || words.empty()) {
     return ErrorReply::Other;
   }
-  std::string_view words = line;
-  words.remove_prefix(6);
   while (!words.empty() && words.front() == ' ') {
     words.remove_prefix(1);
   }

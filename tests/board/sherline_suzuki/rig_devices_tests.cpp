@@ -91,3 +91,23 @@ TEST(RigDevices, AMissingCanInterfaceIsTheHapticDevicesCanLink) {
   STRCMP_CONTAINS("the haptic device's CAN link: ", error.c_str());
   CHECK(devices.device == nullptr);
 }
+
+// A LinuxCNC mill (machine.controller = "linuxcnc"): no serial port is opened, the link is LinuxCNC's
+// (nothing connects until it starts), and commissioning, which measures the CY545 rig's axes, refuses.
+TEST(RigDevices, ALinuxcncMillOpensNoSerialPortAndIsNotCommissionedHere) {
+  RigFacts facts = kRig;
+  facts.controller = MachineController::Linuxcnc;
+  facts.linuxcnc.connect_password = {'h', 'e', 'l', 'l', 'o'};
+  facts.linuxcnc.enable_password = {'e', 'n', 'a', 'b', 'l', 'e'};
+  RigDevices devices;
+  std::string error;
+  // The PIO window is missing, so the haptic link fails; the serial port was never looked at.
+  CHECK_FALSE(open_rig_devices(facts, "/nonexistent/ttyS9", "pio:/nonexistent/uio9", devices, kIgnore, error));
+  STRCMP_CONTAINS("haptic", error.c_str());
+  CHECK(devices.link == nullptr);
+  RigDevices alone;
+  CHECK_FALSE(open_rig_machine(facts, "/nonexistent/ttyS9", alone, error));
+  STRCMP_CONTAINS("LinuxCNC mill", error.c_str());
+  CHECK(alone.link == nullptr);
+  CHECK(alone.linuxcnc == nullptr);
+}

@@ -1,6 +1,7 @@
 // What follows from the rig's facts (board/sherline_suzuki/rig_facts.hpp) for any rig a configuration
 // describes, not only the compiled-in one its static_asserts pin: rounding to steps, the travel past
 // the workspace, the largest backlash, the planner's and the CY545's figures, the device's range.
+#include <cmath>
 #include <string>
 
 #include "board/sherline_suzuki/rig_facts.hpp"
@@ -155,9 +156,9 @@ TEST(RigFacts, TheLinuxcncLinkGetsTheRigsAddressPasswordsGridTravelLongestMoveAn
   DOUBLES_EQUAL(640.0, config.steps_per_mm, 0.0);
   CHECK(config.travel_mm == kRig.workspace_mm);
   DOUBLES_EQUAL(0.57 + 1.0 / 640.0, config.max_move_mm, 1e-12);
-  DOUBLES_EQUAL(360.0, config.feed_mm_per_min, 1e-12);  // 60 * 6 mm/s
+  DOUBLES_EQUAL(60.0 * std::sqrt(3.0) * 6.0, config.feed_mm_per_min, 1e-9);  // a path speed: sqrt(3) * 6 mm/s
   STRCMP_EQUAL("", std::string(hal::linuxcnc::check_linuxcnc_config(config)).c_str());
   // The test INI's mill: every axis 0.5 mm an update, F300.
   DOUBLES_EQUAL(0.5 + 1.0 / 640.0, linuxcnc_config(linuxcnc_mill()).max_move_mm, 1e-12);
-  DOUBLES_EQUAL(300.0, linuxcnc_config(linuxcnc_mill()).feed_mm_per_min, 1e-12);
+  DOUBLES_EQUAL(60.0 * std::sqrt(3.0) * 5.0, linuxcnc_config(linuxcnc_mill()).feed_mm_per_min, 1e-9);
 }

@@ -1,0 +1,152 @@
+#!/usr/bin/env bash
+# stencil-sim with the real LinuxCNC as the mill (ctest label linuxcnc; one ctest e2e.linuxcnc_NAME per
+# function case_NAME): the simulated operator and device, the cycle and the machine side in real time,
+# and sim/linuxcnc_mill's headless LinuxCNC moving its simulated mill; the ground truth is halsampler's
+# every servo period (1 ms) of joint positions, read back by the simulation and cut into its stock.
+# usage: sim_linuxcnc.sh CASE STENCIL_SIM WORK_DIR SOURCE_DIR
+# Without LinuxCNC the case is skipped (77) with a message, unless STENCIL_REQUIRE_LINUXCNC=1 (CI).
+set -uo pipefail
+
+case_name="$1"
+sim="$2"
+work="$3/linuxcnc_$case_name"
+source_dir="$4"
+launcher="$source_dir/sim/linuxcnc_mill/linuxcnc-sim.sh"
+failures=0
+
+if ! command -v linuxcnc >/dev/null 2>&1; then
+  if [ "${STENCIL_REQUIRE_LINUXCNC:-0}" = 1 ]; then
+    echo "FAIL: LinuxCNC is not installed, and STENCIL_REQUIRE_LINUXCNC=1 (bash toolchain/install-deps.sh installs linuxcnc-uspace)" >&2
+    exit 1
+  fi
+  echo "skipped: LinuxCNC is not installed (bash toolchain/install-deps.sh installs linuxcnc-uspace)"
+  exit 77
+fi
+
+rm -rf "$work"
+mkdir -p "$work"
+chmod 755 "$work"
+cd "$work" || exit 1
+mill="$work/mill"  # LinuxCNC's instance folder
+
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+stop_mill() { bash "$launcher" stop "$mill" > stop.txt 2>&1; }
+trap stop_mill EXIT
+
+json_number() {
+  grep -E "\"$2\": " "$1" | head -n 1 | sed -E 's/.*": ([-0-9.eE+]+|null).*/\1/'
+}
+at_most() {
+  awk -v v="$1" -v l="$2" 'BEGIN { exit !(v != "null" && v + 0 <= l + 0) }' || fail "$3 is $1; expected at most $2"
+}
+
+start_mill() {
+  bash "$launcher" start "$mill" > start.txt 2>&1 || { cat start.txt >&2; fail "LinuxCNC did not start"; exit 1; }
+}
+
+# The rig's LinuxCNC configuration pointed at this instance's INI (a copy: the file must be its
+# owner's only).
+rig_config() {
+  sed "s|^ini = .*|ini = \"$mill/mill.ini\"|" "$source_dir/board/sherline_suzuki/rig-linuxcnc.toml" > rig.toml
+  chmod 600 rig.toml
+}
+
+# run_sim ARGS...: the raster job on a corner of the hex prism, in real time; status in $status.
+run_sim() {
+  "$sim" --config rig.toml --speed 1 --pattern raster --stock 40,17,0,48,23,20 --linuxcnc-samples "$mill/samples.txt" \
+    --out-dir jobs --keep-jobs 0 --report report.json "$@" > stdout.txt 2> stderr.txt
+  status=$?
+  echo "$ stencil-sim $* -> exit $status"
+  sed 's/^/  stdout: /' stdout.txt
+  sed 's/^/  stderr: /' stderr.txt
+}
+
+# A fault in the middle of a cut: a safe state for the machine's reason, in LinuxCNC's words, the
+# force zero in that very cycle (the journal's last cycle: the run ends on it), within a machine
+# fault (fault.ns: CLOCK_MONOTONIC as the command that makes it starts; halcmd's own start-up, about
+# 0.1 to 0.2 s, is in the figure), no gouge.
+fault_ends_safe() {
+  local what=$1 words=$2 journal_tool last fault_ns safe_ns
+  journal_tool="$(dirname "$sim")/stencil-journal"
+  [ "$status" = 3 ] || fail "$what: exit status $status; expected 3 (a safe state)"
+  grep -q '"safe_state": "machine_fault"' report.json || fail "$what: not a machine_fault: $(grep '"safe_state"' report.json)"
+  grep -q "$words" report.json || fail "$what: LinuxCNC's words '$words' are not in the report"
+  last=$("$journal_tool" cycles jobs/latest/job.journal | tail -n 1)
+  echo "$last" | grep -q '"force_n": \[0, 0, 0\]' || fail "$what: the safe state's cycle has a force: $last"
+  echo "$last" | grep -q '"safe_state": "machine_fault"' || fail "$what: the last cycle is not the safe state's: $last"
+  if [ -s fault.ns ]; then
+    fault_ns=$(cat fault.ns)
+    safe_ns=$(echo "$last" | sed -E 's/.*"time_ns": ([0-9]+).*/\1/')
+    echo "$what: the safe state $(( (safe_ns - fault_ns) / 1000000 )) ms after the command that made the fault started"
+    [ $(( safe_ns - fault_ns )) -le 400000000 ] ||
+      fail "$what: the safe state came $(( (safe_ns - fault_ns) / 1000000 )) ms after the fault's command started; expected within 400 ms (its start-up and one machine update)"
+  fi
+  at_most "$(json_number report.json max_depth_mm)" 0.005 "$what: the deepest gouge (mm)"
+}
+
+# now_ns: CLOCK_MONOTONIC, as the journal's times.
+now_ns() { python3 -c 'import time; print(time.monotonic_ns())'; }
+
+# The raster job on the real LinuxCNC: no gouge over 0.005 mm from the sampled ground truth.
+case_raster_job_leaves_no_gouge() {
+  start_mill
+  rig_config
+  run_sim --duration 60
+  [ "$status" = 0 ] || fail "exit status $status; expected 0"
+  at_most "$(json_number report.json max_depth_mm)" 0.005 "the deepest gouge (mm)"
+  grep -q '"safe_state": null' report.json || fail "the run ended in a safe state: $(grep safe_state report.json)"
+  [ "$(json_number report.json updates)" -gt 100 ] || fail "only $(json_number report.json updates) machine updates"
+}
+
+case_estop_mid_cut_is_a_safe_state() {
+  start_mill
+  rig_config
+  (sleep 12; now_ns > fault.ns; bash "$launcher" estop "$mill" press > estop.txt 2>&1; now_ns > fault_done.ns) &
+  run_sim --duration 30
+  wait
+  fault_ends_safe "e-stop" "e-stop"
+}
+
+case_killed_mid_cut_is_a_safe_state() {
+  start_mill
+  rig_config
+  (sleep 12; now_ns > fault.ns; bash "$launcher" kill "$mill" > kill.txt 2>&1) &
+  run_sim --duration 30
+  wait
+  fault_ends_safe "LinuxCNC killed" "the connection to linuxcncrsh"
+}
+
+case_following_error_is_a_safe_state() {
+  start_mill
+  rig_config
+  (sleep 12; bash "$launcher" ferror "$mill" 0 0.05 > ferror.txt 2>&1; bash "$launcher" ferror "$mill" 1 0.05 >> ferror.txt 2>&1) &
+  run_sim --duration 30
+  wait
+  fault_ends_safe "following error" "following error"
+}
+
+case_not_running_is_refused_at_start() {
+  bash "$launcher" start "$mill" > start.txt 2>&1 && bash "$launcher" stop "$mill" > /dev/null 2>&1  # the INI, no LinuxCNC
+  rig_config
+  run_sim --duration 10
+  [ "$status" != 0 ] || fail "a job ran with no LinuxCNC"
+  grep -q "nothing answers at 127.0.0.1 port 5007" stdout.txt stderr.txt || fail "the refusal does not say nothing answers"
+}
+
+case_default_passwords_are_refused() {
+  start_mill
+  rig_config
+  sed -i 's/^connect_password = .*/connect_password = "EMC"/; s/^enable_password = .*/enable_password = "EMCTOO"/' rig.toml
+  run_sim --duration 10
+  [ "$status" = 2 ] || fail "exit status $status; expected 2 (bad input)"
+  grep -q "EMC" stderr.txt || fail "the refusal does not name the default passwords"
+}
+
+"case_$case_name"
+if [ "$failures" -gt 0 ]; then
+  echo "$failures failure(s); the case's files are in $work" >&2
+  exit 1
+fi
