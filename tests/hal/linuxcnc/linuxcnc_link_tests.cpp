@@ -11,6 +11,7 @@
 #include <sys/wait.h>
 
 #include "hal/linuxcnc/linuxcnc_link.hpp"
+#include "hal/linuxcnc/tcp_line_channel.hpp"
 #include "hal/posix_clock/monotonic_clock.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
@@ -245,4 +246,24 @@ TEST(LinuxcncLink, AMoveLinuxcncRefusesIsAFaultInItsWords) {
   CHECK_FALSE(result.done);
   CHECK(link.status().fault == MachineFault::ControllerError);
   STRCMP_CONTAINS("would exceed", link.last_error());
+}
+
+// The path the planner checked is the path the mill moves: after homing, LinuxCNC's interpreter is in
+// exact-path mode (G61: no blending of corners), millimetres and absolute, as a second connection
+// (a get needs no enable) reads from LinuxCNC itself.
+TEST(LinuxcncLink, AfterHomingLinuxcncMovesInExactPathMillimetresAbsolute) {
+  start_mill();
+  LinuxcncLink link(clock, mill_config());
+  ready(link);
+  TcpLineChannel watcher(clock);
+  CHECK(watcher.connect("127.0.0.1", mill_config().port, in(kSecond)) == LineStatus::Ok);
+  std::string_view line;
+  CHECK(watcher.send_line("get program_codes", in(kSecond)) == LineStatus::Ok);
+  CHECK(watcher.read_line(line, in(kSecond)) == LineStatus::Ok);
+  const std::string codes(line);
+  STRCMP_CONTAINS("PROGRAM_CODES", codes.c_str());
+  STRCMP_CONTAINS(" G61 ", codes.c_str());
+  STRCMP_CONTAINS(" G21 ", codes.c_str());
+  STRCMP_CONTAINS(" G90 ", codes.c_str());
+  CHECK(codes.find(" G64 ") == std::string::npos);
 }
