@@ -73,7 +73,7 @@ fault_ends_safe() {
   journal_tool="$(dirname "$sim")/stencil-journal"
   [ "$status" = 3 ] || fail "$what: exit status $status; expected 3 (a safe state)"
   grep -q '"safe_state": "machine_fault"' report.json || fail "$what: not a machine_fault: $(grep '"safe_state"' report.json)"
-  grep -q "$words" report.json || fail "$what: LinuxCNC's words '$words' are not in the report"
+  grep -q -i "$words" report.json || fail "$what: LinuxCNC's words '$words' are not in the report"
   last=$("$journal_tool" cycles jobs/latest/job.journal | tail -n 1)
   echo "$last" | grep -q '"force_n": \[0, 0, 0\]' || fail "$what: the safe state's cycle has a force: $last"
   echo "$last" | grep -q '"safe_state": "machine_fault"' || fail "$what: the last cycle is not the safe state's: $last"
