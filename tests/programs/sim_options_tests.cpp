@@ -159,3 +159,15 @@ TEST(SimOptions, ABadMillTruthFileIsNamedAsThat) {
   CHECK_FALSE(app::apply_sim_config(c.app, c.options, error));
   CHECK_EQUAL(0U, error.find("--mill-truth: "));
 }
+
+// --linuxcnc-samples is the ground truth of a LinuxCNC mill: refused, named, with a CY545 rig (the
+// compiled-in one here). The LinuxCNC configuration's own refusals (no --speed 1, no samples, a
+// simulated mill's options) run end to end in e2e.linuxcnc_*.
+TEST(SimOptions, LinuxcncSamplesWithoutALinuxcncConfigurationAreRefused) {
+  Checked c({"--speed", "1", "--linuxcnc-samples", "/tmp/samples.txt"});
+  CHECK_TRUE(c.ok);
+  std::string error;
+  CHECK_FALSE(app::apply_sim_config(c.app, c.options, error));
+  STRCMP_CONTAINS("--linuxcnc-samples: only with a --config whose machine.controller is \"linuxcnc\"", error.c_str());
+  CHECK_FALSE(c.options.linuxcnc.has_value());
+}
