@@ -75,6 +75,9 @@ void add_record_options(CLI::App& app, SimOptions& o) {
   app.add_option("--script-csv", o.script_csv_path,
                  "write the operator's script (the pattern's or --operator's, after a --resume's way back) to this CSV "
                  "in the --operator format before the job runs: a random job's moves, to cut a piece out as a job of its own");
+  app.add_option("--gcode", o.gcode_path,
+                 "at the end, write the path the mill was commanded as a G-code program any CNC can run (as "
+                 "stencil-journal gcode writes it from the job's journal: mm, absolute, work coordinates, G61)");
   app.add_option("--trace", o.trace_path, "write the simulated mill's true path corners to this CSV (t_s,x_mm,y_mm,z_mm)");
   app.add_option("--haptic-transport", o.transport,
                  "how the cycle reaches the simulated device: in process, or through the real PIO shared-memory or "
@@ -165,6 +168,8 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
   } else if (o.no_journal && !o.journal_path.empty()) {
     error = "--journal and --no-journal: choose one";
+  } else if (!o.gcode_path.empty() && o.no_journal) {
+    error = "--gcode writes the program from the job's journal: not with --no-journal, --replay or --commission";
   } else if (!o.device_log_path.empty() && (o.transport != "pio" || !o.inject_text.empty())) {
     error = "--device-process: the device runs in its own process only with --haptic-transport pio and no --inject";
   } else if (o.fast == (o.speed > 0.0)) {

@@ -49,6 +49,7 @@ struct SimOptions {
   std::string resume_path;
   std::string replay_path;
   std::string stock_csv_path;
+  std::string gcode_path;        // --gcode: the cut written as a program at the end (from the journal)
   std::string device_log_path;
   std::string trace_path;
   std::string script_csv_path;

@@ -8,9 +8,19 @@
 
 #include <CLI/CLI.hpp>
 
+#include "board/sherline_suzuki/rig_config.hpp"
 #include "firmware/core/control/safe_state.hpp"
+#include "firmware/core/tables/table_loader.hpp"
+#include "firmware/programs/table_file.hpp"
+#include "firmware/services/gcode/journal_gcode.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
 #include "firmware/services/report/build_version.hpp"
+
+#if STENCIL_BAKED_TABLE
+// The baked-in sample part (the hex prism), linked into its own read-only section.
+extern const unsigned char stencil_table_hex_prism[];
+extern const std::size_t stencil_table_hex_prism_size;
+#endif
 
 namespace {
 
@@ -120,6 +130,63 @@ int read(const std::string& path, bool cycles_json) {
   return kExitRead;
 }
 
+struct GcodeOptions {
+  std::string out_path;
+  std::string tables_path;
+  std::string config_path;
+  double merge_tolerance_mm = 0.001;
+  double spindle_rpm = 2800.0;
+};
+
+bool load_part(const std::string& tables_path, std::vector<unsigned char>& bytes, tables::PartTables& part, std::string& error) {
+  if (!tables_path.empty()) {
+    return app::load_table_file(tables_path, bytes, part, error);
+  }
+#if STENCIL_BAKED_TABLE
+  const tables::TableLoadResult loaded =
+      tables::load_tables({reinterpret_cast<const std::byte*>(stencil_table_hex_prism), stencil_table_hex_prism_size}, part);
+  if (!loaded.ok) {
+    error = std::string("the baked-in table does not load: ") + loaded.field;
+  }
+  return loaded.ok;
+#else
+  error = "--tables: this build has no baked-in part: give the job's table file";
+  return false;
+#endif
+}
+
+// The journal's cut as a G-code program, on the job's own tables and rig (both checked against the
+// journal: the rig's home and machine decide the path the mill was commanded).
+int write_gcode(const std::string& journal_path, const GcodeOptions& o) {
+  std::string error;
+  std::vector<unsigned char> bytes;
+  tables::PartTables part{};
+  board::sherline_suzuki::RigConfig config;
+  if (!load_part(o.tables_path, bytes, part, error) ||
+      (!o.config_path.empty() && !board::sherline_suzuki::read_rig_config(o.config_path, config, error))) {
+    std::fprintf(stderr, "stencil-journal: %s\n", error.c_str());
+    return kExitUsage;
+  }
+  gcode::JournalExport settings;
+  const motion::PlannerLimits limits = board::sherline_suzuki::planner_limits(config.facts);
+  settings.path.path = limits.path;
+  settings.path.update_s = limits.update_period_s;
+  settings.path.home_world_mm = {config.work_offset_mm[0], config.work_offset_mm[1], config.work_offset_mm[2]};
+  settings.program.safe_z_mm = config.work_offset_mm[2];
+  settings.program.spindle_rpm = o.spindle_rpm;
+  settings.merge_tolerance_mm = o.merge_tolerance_mm;
+  settings.source_name = journal_path;
+  settings.config_crc32 = o.config_path.empty() ? 0 : config.file_crc32;
+  gcode::ExportSummary summary;
+  if (!gcode::export_journal_gcode(journal_path, part, settings, o.out_path, summary, error)) {
+    std::fprintf(stderr, "stencil-journal: %s\n", error.c_str());
+    return kExitUnreadable;
+  }
+  std::printf("gcode: %s\ntargets: %" PRIu64 "\nlegs: %" PRIu64 "\nmoves_written: %" PRIu64 "\nfeed_length_mm: %.3f\n",
+              o.out_path.c_str(), summary.targets, summary.legs, summary.moves, summary.feed_length_mm);
+  return kExitRead;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -134,12 +201,31 @@ int main(int argc, char** argv) {
                                                   "tip_mm and force_n (null where the journal kept only the tip's "
                                                   "CRC-32, tip_check), touched, safe_state");
   cycles->add_option("journal", path, "the journal file")->required();
+  GcodeOptions gcode_options;
+  CLI::App* gcode = app.add_subcommand(
+      "gcode", "the path the mill was commanded as a G-code program any CNC can run: mm, absolute, the part's "
+               "work coordinates, exact path (G61); feeds from the recorded timing; backlash take-ups left out; "
+               "collinear runs merged, every merge off the recorded path checked legal on the job's tables");
+  gcode->add_option("journal", path, "the job's journal")->required();
+  gcode->add_option("-o,--output", gcode_options.out_path, "the program to write (.ngc)")->required();
+  gcode->add_option("--tables", gcode_options.tables_path, "the job's .stbl (default: the baked-in hex prism)");
+  gcode->add_option("--config", gcode_options.config_path,
+                    "the job's rig configuration (default: the compiled-in rig): its home, and its machine's path "
+                    "(the CY545's one-axis legs, LinuxCNC's straight segments)");
+  gcode->add_option("--merge-tolerance", gcode_options.merge_tolerance_mm,
+                    "mm a merged move may leave the recorded corners by (each such merge checked legal)")
+      ->capture_default_str()->check(CLI::Range(0.0, 0.1));
+  gcode->add_option("--spindle-rpm", gcode_options.spindle_rpm, "the spindle speed written (S)")
+      ->capture_default_str()->check(CLI::Range(1.0, 100000.0));
   app.footer("Exit status: 0 read (a torn tail is reported, not an error), 1 not a journal or damaged (the offset "
              "and what was expected on stderr), 2 usage.");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return e.get_exit_code() == 0 ? app.exit(e) : (app.exit(e), kExitUsage);  // --help and --version: 0
+  }
+  if (gcode->parsed()) {
+    return write_gcode(path, gcode_options);
   }
   return read(path, cycles->parsed());
 }

@@ -2,6 +2,7 @@
 // on a pseudo-terminal and the simulated mill, on the baked-in sample part or a table file; reports
 // gouges, coverage and loop timing.
 #include <algorithm>
+#include <cinttypes>
 #include <chrono>
 #include <ctime>
 #include <cstdio>
@@ -33,6 +34,7 @@
 #include "firmware/programs/sim_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
+#include "firmware/services/gcode/journal_gcode.hpp"
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
 #include "firmware/core/tables/table_loader.hpp"
@@ -437,7 +439,27 @@ board::sim::SimResult run(const app::SimOptions& o, board::sim::SimJob& job) {
 
 // After the run: the journal ended in order (or, when nothing ran, every output of this run undone),
 // the summary, the report, the picture and the stock's heights. The program's exit status.
-int finish(const app::SimOptions& o, board::sim::SimResult& result, const journal::JobJournalRequest& request,
+// --gcode: the program from the journal just closed, as stencil-journal gcode writes it.
+bool write_gcode(const app::SimOptions& o, const tables::PartTables& part, const std::string& journal_path,
+                 std::string& error) {
+  gcode::JournalExport settings;
+  const motion::PlannerLimits limits = board::sherline_suzuki::planner_limits(o.rig.facts);
+  settings.path.path = limits.path;
+  settings.path.update_s = limits.update_period_s;
+  settings.path.home_world_mm = sim_home(o.rig);
+  settings.program.safe_z_mm = o.rig.home_world_mm[2];
+  settings.source_name = journal_path;
+  settings.config_crc32 = o.config_crc32;
+  gcode::ExportSummary summary;
+  if (!gcode::export_journal_gcode(journal_path, part, settings, o.gcode_path, summary, error)) {
+    return false;
+  }
+  std::printf("gcode: %s (%" PRIu64 " moves from %" PRIu64 " machine targets)\n", o.gcode_path.c_str(), summary.moves,
+              summary.targets);
+  return true;
+}
+
+int finish(const app::SimOptions& o, const tables::PartTables& part, board::sim::SimResult& result, const journal::JobJournalRequest& request,
            journal::JournalWriter& journal_writer, const std::string& journal_path, const report::Provenance& provenance,
            report::JobFolder& folder) {
   std::string error;
@@ -470,6 +492,9 @@ int finish(const app::SimOptions& o, board::sim::SimResult& result, const journa
     return bad_input(error);
   }
   std::printf("report: %s\npicture: %s\n", o.report_path.c_str(), picture_path.c_str());
+  if (!o.gcode_path.empty() && !write_gcode(o, part, journal_path, error)) {
+    return bad_input("--gcode: " + error);
+  }
   // A journal that lost records is not a job done, even if the cut itself ended well.
   return result.safe_state == control::SafeReason::None && result.journal_error.empty() ? kExitDone : kExitSafeState;
 }
@@ -593,5 +618,5 @@ int main(int argc, char** argv) {
                    : std::string(", in the safe state (") + control::safe_reason_name(result.safe_state) + ")"));
   display.stop();
   files.close();
-  return finish(o, result, request, journal_writer, journal_path, provenance, folder);
+  return finish(o, part, result, request, journal_writer, journal_path, provenance, folder);
 }
