@@ -83,6 +83,13 @@ struct SimJob {
 
 using report::Quantiles;
 
+// A G-code program's source line whose move would have taken the tool into the part: the stencil
+// refused or shortened it (gcode_job.hpp). depth_mm: the deepest its move would have gone.
+struct GcodeRefusal {
+  int line;
+  double depth_mm;
+};
+
 struct SimResult {
   bool started = false;          // false: the machine never came up (see error)
   std::string error;
@@ -142,6 +149,11 @@ struct SimResult {
   control::SafeReason replay_recorded_reason = control::SafeReason::None;
   std::uint64_t replay_commands_not_given = 0;
   std::uint32_t touched_rebuilt = 0;
+  // A G-code program as the operator (--gcode-operator) or cut directly (--gcode-direct): its path
+  // ("" for neither), and the lines the stencil refused or shortened (the operator's only).
+  std::string gcode_program;
+  bool gcode_direct = false;
+  std::vector<GcodeRefusal> gcode_refused;
   report::OperatorRecord operator_record;  // what the operator did, where everything ended
   // Memory: resident once the job was set up (the journal rebuilt, the machine homed), at its end,
   // and the most it ever was (kB).

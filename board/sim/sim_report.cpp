@@ -35,6 +35,18 @@ report::JobFigures figures_of(const SimResult& r) {
 
 // What only the simulation measures: the ground truth of what was cut, the injected fault, the
 // simulated mill as the stop left it, the journal and the process's memory.
+// The G-code program's section: which program, how it ran, and (as the operator) each source line
+// whose move the stencil refused or shortened with how deep it would have gone.
+nlohmann::json gcode_section(const SimResult& r) {
+  nlohmann::json refused = nlohmann::json::array();
+  for (const GcodeRefusal& refusal : r.gcode_refused) {
+    refused.push_back({{"line", refusal.line}, {"depth_mm", refusal.depth_mm}});
+  }
+  return {{"program", r.gcode_program},
+          {"run", r.gcode_direct ? "direct" : "operator"},
+          {"refused", r.gcode_direct ? nlohmann::json(nullptr) : refused}};
+}
+
 nlohmann::json simulation_sections(const SimResult& r) {
   return {
       {"job", {{"total_simulated_s", r.earlier.recorded_s + r.simulated_s}}},
@@ -103,7 +115,11 @@ bool write_report_json(const std::string& path, const SimResult& r, const report
                        std::string& error) {
   report::JobFigures figures = figures_of(r);
   figures.provenance = provenance;
-  return report::write_job_report(path, figures, simulation_sections(r), error);
+  nlohmann::json sections = simulation_sections(r);
+  if (!r.gcode_program.empty()) {
+    sections["gcode"] = gcode_section(r);  // only with a program: every other job's report is as before
+  }
+  return report::write_job_report(path, figures, sections, error);
 }
 
 std::string summary(const SimResult& r) {
@@ -131,6 +147,15 @@ std::string summary(const SimResult& r) {
                   r.wakeup_latency_us.p99, r.wakeup_latency_us.p999, r.wakeup_latency_us.max,
                   static_cast<unsigned long long>(r.overruns), static_cast<unsigned long long>(r.missed_periods));
     out += text;
+  }
+  if (!r.gcode_program.empty() && !r.gcode_direct) {
+    out += "gcode: " + std::to_string(r.gcode_refused.size()) + " line" + (r.gcode_refused.size() == 1 ? "" : "s") +
+           " of " + r.gcode_program + " refused or shortened by the stencil" + (r.gcode_refused.empty() ? "" : ":");
+    for (const GcodeRefusal& refusal : r.gcode_refused) {
+      std::snprintf(text, sizeof text, " line %d (%.3f mm deep)", refusal.line, refusal.depth_mm);
+      out += text;
+    }
+    out += "\n";
   }
   if (!r.journal_error.empty()) {
     out += "journal: " + r.journal_error + "\n";

@@ -52,9 +52,26 @@ void fill_statistics(SimResult& result, const runtime::Job& job, const runtime::
   result.machine_stopped_s = outcome.machine_stopped_s;
 }
 
-// What was machined, for the picture, and the controller's model beside it: each model cell against
-// the mill's cell under its centre.
+// The controller's model beside what was machined: each model cell against the mill's cell under its centre.
 void fill_stock(SimResult& result, const control::CommandedStock& model, const stencil::sim::MachinedPart& machined) {
+  fill_machined(result, machined);
+  const stencil::sim::StockZmap& stock = machined.stock();
+  result.model_removed_volume_mm3 = model.removed_volume_mm3();
+  for (int row = 0; row < model.rows(); ++row) {
+    for (int column = 0; column < model.columns(); ++column) {
+      const double x = model.block().low_mm.x() + (column + 0.5) * model.cell_mm();
+      const double y = model.block().low_mm.y() + (row + 0.5) * model.cell_mm();
+      const int c = std::clamp(static_cast<int>((x - stock.box().low_mm.x()) / stock.cell_mm()), 0, stock.columns() - 1);
+      const int r = std::clamp(static_cast<int>((y - stock.box().low_mm.y()) / stock.cell_mm()), 0, stock.rows() - 1);
+      result.model_max_difference_mm = std::max(result.model_max_difference_mm, std::abs(model.height(column, row) - stock.height(c, r)));
+    }
+  }
+}
+
+}  // namespace
+
+// What was machined: the volumes, the gouge and the stock's heights for the picture.
+void fill_machined(SimResult& result, const stencil::sim::MachinedPart& machined) {
   stencil::sim::MachinedPart::Volumes volumes = machined.volumes();
   result.gouge_max_depth_mm = machined.max_gouge_mm();
   result.gouge_measured = machined.gouge_measured();
@@ -75,19 +92,7 @@ void fill_stock(SimResult& result, const control::CommandedStock& model, const s
   result.part_heights = machined.part_heights();
   result.unmachined_heights = std::move(volumes.unmachined_per_cell_mm);
   result.signed_distance_mm = machined.signed_distances(result.part_heights, kSignedDistanceReachMm);
-  result.model_removed_volume_mm3 = model.removed_volume_mm3();
-  for (int row = 0; row < model.rows(); ++row) {
-    for (int column = 0; column < model.columns(); ++column) {
-      const double x = model.block().low_mm.x() + (column + 0.5) * model.cell_mm();
-      const double y = model.block().low_mm.y() + (row + 0.5) * model.cell_mm();
-      const int c = std::clamp(static_cast<int>((x - stock.box().low_mm.x()) / stock.cell_mm()), 0, stock.columns() - 1);
-      const int r = std::clamp(static_cast<int>((y - stock.box().low_mm.y()) / stock.cell_mm()), 0, stock.rows() - 1);
-      result.model_max_difference_mm = std::max(result.model_max_difference_mm, std::abs(model.height(column, row) - stock.height(c, r)));
-    }
-  }
 }
-
-}  // namespace
 
 double reachable_coverage(const tables::PartTables& part, const engine::TriangleSet& touched) {
   if (part.header.reachable_triangle_count == 0) {

@@ -21,6 +21,9 @@ namespace stencil::board::sim {
 // This process's resident memory now (kB).
 [[nodiscard]] std::int64_t resident_kb();
 
+// What the mill machined into `result`: volumes, gouge, the stock's and the part's heights.
+void fill_machined(SimResult& result, const stencil::sim::MachinedPart& machined);
+
 // Fills the rest of `result` (what the run's hooks reported is in it already): in real time the
 // wake-up latency is the cycle's; in virtual time there is none to speak of.
 void fill_result(SimResult& result, const runtime::Job& job, const runtime::RunOutcome& outcome, const SimMachine& mill,

@@ -10,6 +10,20 @@ namespace {
 void add_operator_options(CLI::App& app, SimOptions& o) {
   app.add_option("--tables", o.tables_path, "the part's .stbl (default: the baked-in hex prism, ball end mill d = 3 mm)");
   app.add_option("--operator", o.operator_path, "the operator's script: CSV rows t_s,x_mm,y_mm,z_mm[,a_rad,b_rad] in device space");
+  app.add_option("--gcode-operator", o.gcode_operator_path,
+                 "a CAM program (G-code) as the operator's motion, interpreted by LinuxCNC's rs274: the hand follows "
+                 "its moves at their feeds (at most what the mill can follow), the stencil keeps the tool out of the "
+                 "part, and the report lists each source line whose move it refused or shortened, with how deep that "
+                 "move would have gone (gcode.refused). Refused, naming the line: cutter compensation, canned cycles, "
+                 "G33, probing, a tool change after the first move");
+  app.add_option("--gcode-direct", o.gcode_direct_path,
+                 "cut a G-code program (interpreted by rs274) straight into the simulated stock with no stencil and "
+                 "no controller: what the program does on a mill as it is; the report, picture and --stock-csv as a "
+                 "job's (a stencil-sim --gcode program cut again must leave the job's stock)");
+  app.add_option("--gcode-arc-tolerance", o.gcode_arc_tolerance_mm,
+                 "mm: a G-code arc is followed as chords that stray from it by at most this")
+      ->check(CLI::Range(1e-5, 0.1))
+      ->capture_default_str();
   app.add_option("--pattern", o.pattern_name, "the operator's pattern when there is no --operator file")
       ->check(CLI::IsMember({"raster", "plunge", "thinwall", "random"}))
       ->capture_default_str();
@@ -162,12 +176,23 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     o.fast = o.fast || o.speed == 0.0;
     o.no_journal = true;
   }
+  if (!o.gcode_direct_path.empty() && !o.fast && o.speed == 0.0) {
+    o.fast = true;  // no clock to speak of: the program's moves are cut one after another
+  }
   if (!o.jobs.out_dir.empty() && (!o.resume_path.empty() || !o.replay_path.empty())) {
     error = "--out-dir: a --resume or a --replay writes in its journal's folder";
   } else if (!o.resume_path.empty() && (!o.journal_path.empty() || o.no_journal)) {
     error = "--resume carries on in the journal it resumes: no --journal or --no-journal with it";
   } else if (o.no_journal && !o.journal_path.empty()) {
     error = "--journal and --no-journal: choose one";
+  } else if (!o.gcode_operator_path.empty() && !o.operator_path.empty()) {
+    error = "--operator and --gcode-operator: choose one";
+  } else if (!o.gcode_direct_path.empty() &&
+             (!o.operator_path.empty() || !o.gcode_operator_path.empty() || !o.resume_path.empty() || !o.replay_path.empty() ||
+              !o.inject_text.empty() || !o.gcode_path.empty() || o.commission || o.display.requested() ||
+              app.count("--device-process") + app.count("--journal") + app.count("--linuxcnc-samples") > 0)) {
+    error = "--gcode-direct cuts the program with no controller: no --operator, --gcode-operator, --resume, --replay, "
+            "--inject, --gcode, --commission, --journal, --device-process, --linuxcnc-samples or display with it";
   } else if (!o.gcode_path.empty() && o.no_journal) {
     error = "--gcode writes the program from the job's journal: not with --no-journal, --replay or --commission";
   } else if (!o.device_log_path.empty() && (o.transport != "pio" || !o.inject_text.empty())) {

@@ -30,6 +30,9 @@ struct SimOptions {
   JobFolderOptions jobs;      // --out-dir, --keep-jobs, --keep-mb
   std::string tables_path;    // empty: the baked-in hex prism
   std::string operator_path;  // empty: the pattern
+  std::string gcode_operator_path;  // --gcode-operator: a CAM program as the operator's motion
+  std::string gcode_direct_path;    // --gcode-direct: a program cut by the simulated mill with no stencil
+  double gcode_arc_tolerance_mm = 0.001;
   std::string pattern_name = "raster";
   std::uint64_t seed = 1;
   int moves = 200;

@@ -136,6 +136,7 @@ struct GcodeOptions {
   std::string config_path;
   double merge_tolerance_mm = 0.001;
   double spindle_rpm = 2800.0;
+  std::string frame = "work";
 };
 
 bool load_part(const std::string& tables_path, std::vector<unsigned char>& bytes, tables::PartTables& part, std::string& error) {
@@ -177,6 +178,8 @@ int write_gcode(const std::string& journal_path, const GcodeOptions& o) {
   settings.merge_tolerance_mm = o.merge_tolerance_mm;
   settings.source_name = journal_path;
   settings.config_crc32 = o.config_path.empty() ? 0 : config.file_crc32;
+  settings.machine_coordinates = o.frame == "machine";
+  settings.machine_sign = config.facts.machine_sign;
   gcode::ExportSummary summary;
   if (!gcode::export_journal_gcode(journal_path, part, settings, o.out_path, summary, error)) {
     std::fprintf(stderr, "stencil-journal: %s\n", error.c_str());
@@ -215,6 +218,12 @@ int main(int argc, char** argv) {
   gcode->add_option("--merge-tolerance", gcode_options.merge_tolerance_mm,
                     "mm a merged move may leave the recorded corners by (each such merge checked legal)")
       ->capture_default_str()->check(CLI::Range(0.0, 0.1));
+  gcode->add_option("--frame", gcode_options.frame,
+                    "work: the part's coordinates (G54 set so that the part's origin is X0 Y0 Z0); machine: the "
+                    "machine's own (G53 on every move, 0 at home, each axis counted as the configuration's "
+                    "machine.axis_sign says), for a machine whose axes count against the part's")
+      ->check(CLI::IsMember({"work", "machine"}))
+      ->capture_default_str();
   gcode->add_option("--spindle-rpm", gcode_options.spindle_rpm, "the spindle speed written (S)")
       ->capture_default_str()->check(CLI::Range(1.0, 100000.0));
   app.footer("Exit status: 0 read (a torn tail is reported, not an error), 1 not a journal or damaged (the offset "

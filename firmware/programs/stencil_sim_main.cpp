@@ -34,6 +34,7 @@
 #include "firmware/programs/sim_options.hpp"
 #include "firmware/programs/table_file.hpp"
 #include "firmware/runtime/realtime_thread.hpp"
+#include "board/sim/gcode_job.hpp"
 #include "firmware/services/gcode/journal_gcode.hpp"
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
@@ -245,7 +246,7 @@ bool fits_the_rig(const app::SimOptions& o, const tables::PartTables& part, std:
 // The job the options describe: its stock, the operator's script and, in `job_text`, what makes it
 // the same job when it is resumed (recorded at its start, checked on resume).
 bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::sim::SimJob& job, std::string& job_text,
-              std::string& error) {
+              sim::GcodeProgram& program, std::string& error) {
   job.part = &part;
   job.rig = o.rig;
   job.linuxcnc = o.linuxcnc;
@@ -253,7 +254,16 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
   if (!o.stock_text.empty() && !parse_stock(o.stock_text, part, job.stock, error)) {
     return false;
   }
-  if (!o.operator_path.empty()) {
+  const std::string& gcode_path = o.gcode_operator_path.empty() ? o.gcode_direct_path : o.gcode_operator_path;
+  if (!gcode_path.empty()) {
+    sim::GcodeReadOptions read;
+    read.arc_tolerance_mm = o.gcode_arc_tolerance_mm;
+    if (!sim::read_gcode_program(gcode_path, read, program, error)) {
+      return false;
+    }
+    job.script = board::sim::gcode_script(program, sim_home(job.rig), operator_speed_mm_per_s(job.rig),
+                                          job.rig.facts.haptic_to_machine_scale);
+  } else if (!o.operator_path.empty()) {
     if (!sim::read_operator_csv(o.operator_path, job.script, error)) {
       return false;
     }
@@ -270,9 +280,11 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
   std::snprintf(numbers, sizeof numbers, " seed=%llu moves=%d stock=%.17g,%.17g,%.17g,%.17g,%.17g,%.17g",
                 static_cast<unsigned long long>(o.seed), o.moves, job.stock.low_mm.x(), job.stock.low_mm.y(),
                 job.stock.low_mm.z(), job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z());
+  const std::string operator_text = !o.gcode_operator_path.empty() ? "gcode:" + o.gcode_operator_path
+                                    : o.operator_path.empty()        ? std::string("-")
+                                                                     : o.operator_path;
   job_text = "tables=" + (o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path) +
-             " operator=" + (o.operator_path.empty() ? std::string("-") : o.operator_path) +
-             " pattern=" + (o.operator_path.empty() ? o.pattern_name : std::string("-")) + numbers;
+             " operator=" + operator_text + " pattern=" + (operator_text == "-" ? o.pattern_name : std::string("-")) + numbers;
   // A configured rig (and a mill truth of its own) make it another job; the compiled-in rig's text is as before.
   char files[64] = "";
   if (o.config_crc32 != 0 || o.mill_truth_crc32 != 0) {
@@ -439,6 +451,40 @@ board::sim::SimResult run(const app::SimOptions& o, board::sim::SimJob& job) {
 
 // After the run: the journal ended in order (or, when nothing ran, every output of this run undone),
 // the summary, the report, the picture and the stock's heights. The program's exit status.
+// --gcode-direct: the program's moves cut into the stock with no controller; the report, picture and
+// stock heights as a job's, in the job's folder.
+int cut_directly(app::SimOptions& o, const tables::PartTables& part, const board::sim::SimJob& job,
+                 const sim::GcodeProgram& program) {
+  std::string error;
+  report::JobFolder folder;
+  if (!place_outputs(o, 0, folder, error)) {
+    return bad_input(error);
+  }
+  board::sim::SimResult result;
+  const auto wall_start = std::chrono::steady_clock::now();
+  board::sim::cut_directly(part, job.stock, board::sim::true_frames(job.rig), program, sim_home(job.rig), result);
+  result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  result.gcode_program = o.gcode_direct_path;
+  result.gcode_direct = true;
+  report::Provenance provenance;
+  provenance.program = "stencil-sim";
+  provenance.tables = o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path;
+  provenance.tables_crc32 = part.header.crc32;
+  provenance.triangle_count = part.header.triangle_count;
+  std::printf("gcode-direct: %s, %zu moves cut with no stencil\n", o.gcode_direct_path.c_str(), program.moves.size());
+  std::printf("gouge: %s mm deepest, %.3f mm3 under the part's top\nstock removed %.1f mm3\n",
+              result.gouge_measured ? std::to_string(result.gouge_max_depth_mm).c_str() : "not measured (not a ball end mill)",
+              result.gouge_volume_mm3, result.removed_volume_mm3);
+  const std::string picture_path = picture_path_of(o.report_path);
+  if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
+      !board::sim::write_picture_png(picture_path, result, error) ||
+      (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
+    return bad_input(error);
+  }
+  std::printf("report: %s\npicture: %s\n", o.report_path.c_str(), picture_path.c_str());
+  return kExitDone;
+}
+
 // --gcode: the program from the journal just closed, as stencil-journal gcode writes it.
 bool write_gcode(const app::SimOptions& o, const tables::PartTables& part, const std::string& journal_path,
                  std::string& error) {
@@ -528,9 +574,10 @@ int main(int argc, char** argv) {
   tables::PartTables part{};
   board::sim::SimJob job;
   std::string job_text;
+  sim::GcodeProgram program;
   if (!app::check_sim_options(app, o, error) || !app::apply_sim_config(app, o, error) ||
       !load_part(o.tables_path, file_bytes, part, error) || !fits_the_rig(o, part, error) ||
-      !make_job(o, part, job, job_text, error) ||
+      !make_job(o, part, job, job_text, program, error) ||
       !board::sherline_suzuki::check_stock_fit({job.stock.low_mm.x(), job.stock.low_mm.y(), job.stock.low_mm.z()},
                                                {job.stock.high_mm.x(), job.stock.high_mm.y(), job.stock.high_mm.z()},
                                                o.rig.facts, {o.rig.home_world_mm, 0.0, 0.0}, error)) {
@@ -538,6 +585,9 @@ int main(int argc, char** argv) {
   }
   if (o.commission) {
     return commission(o, job);
+  }
+  if (!o.gcode_direct_path.empty()) {
+    return cut_directly(o, part, job, program);
   }
   report::Provenance provenance;
   provenance.program = "stencil-sim";
@@ -609,6 +659,10 @@ int main(int argc, char** argv) {
   job.display = display.feed();
   job.interrupted = &interrupted;
   board::sim::SimResult result = run(o, job);
+  if (!o.gcode_operator_path.empty()) {
+    result.gcode_program = o.gcode_operator_path;
+    result.gcode_refused = board::sim::refused_lines(part, program, sim_home(job.rig));
+  }
   if (job.progress) {
     std::fprintf(stderr, "\n");
   }

@@ -147,9 +147,9 @@ void MachinedPart::finish_leg() {
 // the flutes. Moved along one axis, it sweeps that capsule's core (a segment) into a vertical
 // rectangle (a horizontal move) or a longer segment (a vertical one), grown by R: a triangle of the
 // part is cut into by R less its distance from that core.
-double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
-  const double radius = part_.tool.envelope.cutter_radius_mm;
-  const double flutes = part_.tool.envelope.flute_length_mm;
+double tool_depth_along(const tables::PartTables& part, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+  const double radius = part.tool.envelope.cutter_radius_mm;
+  const double flutes = part.tool.envelope.flute_length_mm;
   const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
   const Eigen::Vector3d low_from = from + radius * up, low_to = to + radius * up;
   const Eigen::Vector3d high_from = from + flutes * up, high_to = to + flutes * up;
@@ -159,9 +159,9 @@ double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3
   const Eigen::Vector3d box_low = low_from.cwiseMin(low_to).array() - radius;
   const Eigen::Vector3d box_high = high_from.cwiseMax(high_to).array() + radius;
   double deepest = 0.0;
-  for (std::uint32_t t = 0; t < part_.triangle_count(); ++t) {
-    const std::array<Eigen::Vector3d, 3> triangle{vertex(part_.triangles[t], 0), vertex(part_.triangles[t], 1),
-                                                  vertex(part_.triangles[t], 2)};
+  for (std::uint32_t t = 0; t < part.triangle_count(); ++t) {
+    const std::array<Eigen::Vector3d, 3> triangle{vertex(part.triangles[t], 0), vertex(part.triangles[t], 1),
+                                                  vertex(part.triangles[t], 2)};
     const Eigen::Vector3d t_low = triangle[0].cwiseMin(triangle[1]).cwiseMin(triangle[2]);
     const Eigen::Vector3d t_high = triangle[0].cwiseMax(triangle[1]).cwiseMax(triangle[2]);
     if ((t_low.array() > box_high.array()).any() || (t_high.array() < box_low.array()).any()) {
@@ -178,6 +178,10 @@ double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3
     deepest = std::max(deepest, radius - distance);
   }
   return deepest;
+}
+
+double MachinedPart::leg_gouge(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const {
+  return tool_depth_along(part_, from, to);
 }
 
 std::vector<double> part_top_heights(const tables::PartTables& part, const StockZmap& grid) {

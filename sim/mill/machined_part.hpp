@@ -27,6 +27,11 @@ namespace stencil::sim {
 [[nodiscard]] std::vector<double> lowest_tips(const StockZmap& grid, const std::vector<double>& part_heights,
                                               const ToolProfile& tool);
 
+// The deepest a ball end mill's cutter (ball and flutes; the tables' tool) goes into the part's
+// triangles anywhere along the straight move from `from` to `to` (tips, world mm); 0 where it stays
+// clear. The gouge of a leg, and what a G-code move would do to the part unguarded.
+[[nodiscard]] double tool_depth_along(const tables::PartTables& part, const Eigen::Vector3d& from, const Eigen::Vector3d& to);
+
 // One corner of the path the mill followed: where the moving axis changed or motion stopped.
 struct PathCorner {
   double t_s;

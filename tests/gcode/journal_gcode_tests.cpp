@@ -82,6 +82,21 @@ TEST(JournalGcode, TheTargetsBecomeTheirLegsAfterTheHeader) {
   CHECK(text.find("G0 X50 Y25\nG1 X49 F600\nG1 X48 F1800\nG1 Y24\nG1 Z24\nG0 Z25\nM5\nM2\n%\n") != std::string::npos);
 }
 
+TEST(JournalGcode, InMachineCoordinatesEveryMoveIsG53FromHomeAlongTheMachinesAxes) {
+  Fixture f;
+  f.write({{49.0, 25.0, 25.0}, {48.0, 24.0, 24.0}}, f.part.header.crc32);
+  gcode::JournalExport settings = f.settings();
+  settings.machine_coordinates = true;
+  settings.machine_sign = {-1, -1, -1};  // the Sherline's table moves under the tool; Z counts down from home
+  gcode::ExportSummary summary;
+  std::string error;
+  CHECK_TEXT(gcode::export_journal_gcode(f.journal.path, f.part, settings, f.out, summary, error), error.c_str());
+  const std::string text = f.program();
+  CHECK(text.find("G53 G0 Z0\nG53 G0 X0 Y0\nG53 G1 X1 F600\nG53 G1 X2 F1800\nG53 G1 Y1\nG53 G1 Z1\nG53 G0 Z0\nM5\n") !=
+        std::string::npos);
+  CHECK(text.find("the machine's own coordinates") != std::string::npos);
+}
+
 TEST(JournalGcode, OtherTablesThanTheJobsAreRefused) {
   Fixture f;
   f.write({{49.0, 25.0, 25.0}}, f.part.header.crc32 ^ 1U);

@@ -47,11 +47,13 @@ bool write_program(std::FILE* out, const std::vector<CutMove>& moves, const Eige
   ok = ok && std::fprintf(out, "S%s M3\n", number(settings.spindle_rpm).c_str()) > 0;
   // Where the program starts, the machine's position is not known: straight up to the safe height
   // first, then over to the path's start.
-  ok = ok && std::fprintf(out, "G0 Z%s\n", number(settings.safe_z_mm).c_str()) > 0;
+  const char* g0 = settings.motion_prefix.empty() ? "G0" : "G53 G0";
+  const char* g1 = settings.motion_prefix.empty() ? "G1" : "G53 G1";
+  ok = ok && std::fprintf(out, "%s Z%s\n", g0, number(settings.safe_z_mm).c_str()) > 0;
   Eigen::Vector3d at(start_mm.x(), start_mm.y(), settings.safe_z_mm);
-  ok = ok && std::fprintf(out, "G0 X%s Y%s\n", number(at.x()).c_str(), number(at.y()).c_str()) > 0;
+  ok = ok && std::fprintf(out, "%s X%s Y%s\n", g0, number(at.x()).c_str(), number(at.y()).c_str()) > 0;
   if (number(start_mm.z()) != number(at.z())) {
-    ok = ok && std::fprintf(out, "G0 Z%s\n", number(start_mm.z()).c_str()) > 0;
+    ok = ok && std::fprintf(out, "%s Z%s\n", g0, number(start_mm.z()).c_str()) > 0;
   }
   at = start_mm;
   double feed = -1.0;
@@ -61,12 +63,12 @@ bool write_program(std::FILE* out, const std::vector<CutMove>& moves, const Eige
       continue;  // shorter than the written precision
     }
     if (move.kind == MoveKind::Traverse) {
-      ok = ok && std::fprintf(out, "G0 %s\n", words.c_str()) > 0;
+      ok = ok && std::fprintf(out, "%s %s\n", g0, words.c_str()) > 0;
     } else {
       const double length = (move.to_mm - at).norm();
       const double wanted = std::max(settings.min_feed_mm_per_min,
                                      move.seconds > 0.0 ? 60.0 * length / move.seconds : settings.min_feed_mm_per_min);
-      std::string line = "G1 " + words;
+      std::string line = std::string(g1) + " " + words;
       if (feed < 0.0 || std::abs(wanted - feed) > 0.01 * feed) {
         feed = std::round(wanted * 10.0) / 10.0;
         line += " F" + number(std::max(feed, settings.min_feed_mm_per_min));
@@ -75,7 +77,7 @@ bool write_program(std::FILE* out, const std::vector<CutMove>& moves, const Eige
     }
     at = move.to_mm;
   }
-  ok = ok && std::fprintf(out, "G0 Z%s\n", number(std::max(settings.safe_z_mm, at.z())).c_str()) > 0;
+  ok = ok && std::fprintf(out, "%s Z%s\n", g0, number(settings.safe_z_mm).c_str()) > 0;
   ok = ok && std::fprintf(out, "M5\nM2\n%%\n") > 0;
   return ok;
 }

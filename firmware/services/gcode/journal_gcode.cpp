@@ -88,7 +88,25 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
     summary.feed_length_mm += move.kind == MoveKind::Feed ? (move.to_mm - at).norm() : 0.0;
     at = move.to_mm;
   }
+  Eigen::Vector3d start = settings.path.home_world_mm;
+  std::vector<CutMove> moves = merged.moves;
   ProgramSettings program = settings.program;
+  if (settings.machine_coordinates) {
+    const Eigen::Vector3d home = settings.path.home_world_mm;
+    const auto machine = [&](const Eigen::Vector3d& world) {
+      Eigen::Vector3d m;
+      for (int i = 0; i < 3; ++i) {
+        m[i] = settings.machine_sign[static_cast<std::size_t>(i)] * (world[i] - home[i]);
+      }
+      return m;
+    };
+    for (CutMove& move : moves) {
+      move.to_mm = machine(move.to_mm);
+    }
+    start = machine(start);
+    program.safe_z_mm = 0.0;  // home's height: the top of the travel
+    program.motion_prefix = "G53 ";
+  }
   program.tool = tool_name(part);
   char tables_line[160];
   std::snprintf(tables_line, sizeof tables_line, "tables CRC-32 %08" PRIx32 ", %" PRIu32 " triangles; tool: %s", part.header.crc32,
@@ -100,7 +118,9 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
                 summary.targets, summary.legs, settings.merge_tolerance_mm);
   program.comments.insert(program.comments.begin(),
                           {"the legal cut of " + settings.source_name + ", as the mill was commanded", tables_line,
-                           "mm, absolute, work coordinates: set G54 so that the part's origin is X0 Y0 Z0",
+                           settings.machine_coordinates
+                               ? "mm, absolute, the machine's own coordinates (G53 on every move): 0 at home"
+                               : "mm, absolute, work coordinates: set G54 so that the part's origin is X0 Y0 Z0",
                            "feeds from the recorded timing; backlash take-ups left out: the controller compensates its own",
                            merge_line});
   const std::string temporary = out_path + ".partial";
@@ -109,7 +129,7 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
     error = out_path + ": cannot be written";
     return false;
   }
-  const bool written = write_program(out, merged.moves, settings.path.home_world_mm, program);
+  const bool written = write_program(out, moves, start, program);
   const bool closed = std::fclose(out) == 0;
   if (!written || !closed || std::rename(temporary.c_str(), out_path.c_str()) != 0) {
     std::remove(temporary.c_str());

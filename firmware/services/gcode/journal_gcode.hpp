@@ -3,6 +3,7 @@
 // that exports (stencil-journal gcode, stencil-sim --gcode).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 
@@ -17,6 +18,11 @@ struct JournalExport {
   ProgramSettings program;        // its tool and comments are filled in here from the tables
   double merge_tolerance_mm = 0.001;
   std::string source_name;        // what the header says the program came from
+  // Written in the machine's own coordinates (G53 on every move: sign x (world - home) per axis, as its
+  // readout counts) instead of the part's: for a machine whose axes count against the part's, which
+  // no work offset (G54) can map, or to run the cut with no touch-off.
+  bool machine_coordinates = false;
+  std::array<int, 3> machine_sign{1, 1, 1};
   std::uint32_t config_crc32 = 0; // the rig's configuration file these settings came from (0: compiled-in):
                                   // the journal's job must have been run with it
 };
