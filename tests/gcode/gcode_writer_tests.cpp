@@ -90,6 +90,15 @@ TEST(GcodeWriter, TheWayOutRetractsAboveTheLastPointThenStopsTheSpindle) {
   STRCMP_EQUAL("M2", lines[n - 2].c_str());
 }
 
+TEST(GcodeWriter, ParenthesesInACommentDoNotNestIt) {
+  gcode::ProgramSettings s = settings();
+  s.comments = {"the cut of /jobs/a (copy)/job.journal"};
+  s.tool = "ball (3 mm)";
+  const std::vector<std::string> lines = program_lines({}, {50.0, 25.0, 25.0}, s);
+  STRCMP_EQUAL("(the cut of /jobs/a [copy]/job.journal)", lines[1].c_str());
+  STRCMP_EQUAL("T1 M6 (ball [3 mm])", lines[3].c_str());
+}
+
 TEST(GcodeWriter, AFailedWriteIsReported) {
   std::FILE* read_only = std::fopen("/dev/null", "r");
   CHECK(read_only != nullptr);

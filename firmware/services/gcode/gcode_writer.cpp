@@ -34,16 +34,26 @@ std::string axis_words(const Eigen::Vector3d& to, const Eigen::Vector3d& at, boo
   return words;
 }
 
+// G-code comments do not nest: a parenthesis inside one (a path, a tool's name) would end it early or
+// be refused ("Nested comment found").
+std::string comment(const std::string& text) {
+  std::string out = "(";
+  for (const char c : text) {
+    out.push_back(c == '(' ? '[' : c == ')' ? ']' : (c == '\n' || c == '\r') ? ' ' : c);
+  }
+  return out + ")";
+}
+
 }  // namespace
 
 bool write_program(std::FILE* out, const std::vector<CutMove>& moves, const Eigen::Vector3d& start_mm,
                    const ProgramSettings& settings) {
   bool ok = std::fprintf(out, "%%\n") > 0;
   for (const std::string& line : settings.comments) {
-    ok = ok && std::fprintf(out, "(%s)\n", line.c_str()) > 0;
+    ok = ok && std::fprintf(out, "%s\n", comment(line).c_str()) > 0;
   }
   ok = ok && std::fprintf(out, "G21 G90 G94 G17 G40 G49 G54 G61\n") > 0;
-  ok = ok && std::fprintf(out, "T1 M6 (%s)\n", settings.tool.c_str()) > 0;
+  ok = ok && std::fprintf(out, "T1 M6 %s\n", comment(settings.tool).c_str()) > 0;
   ok = ok && std::fprintf(out, "S%s M3\n", number(settings.spindle_rpm).c_str()) > 0;
   // Where the program starts, the machine's position is not known: straight up to the safe height
   // first, then over to the path's start.

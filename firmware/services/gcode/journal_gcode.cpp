@@ -119,7 +119,7 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
   program.comments.insert(program.comments.begin(),
                           {"the legal cut of " + settings.source_name + ", as the mill was commanded", tables_line,
                            settings.machine_coordinates
-                               ? "mm, absolute, the machine's own coordinates (G53 on every move): 0 at home"
+                               ? "mm, absolute, the machine's own coordinates, G53 on every move: 0 at home"
                                : "mm, absolute, work coordinates: set G54 so that the part's origin is X0 Y0 Z0",
                            "feeds from the recorded timing; backlash take-ups left out: the controller compensates its own",
                            merge_line});
