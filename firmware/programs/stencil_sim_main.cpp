@@ -423,9 +423,11 @@ bool check_outputs(const app::SimOptions& o, board::sim::SimJob& job, SideFiles&
 }
 
 void print_banner(const app::SimOptions& o, const board::sim::SimJob& job) {
-  std::printf("stencil-sim: %s, %s pattern over the stock [%.1f,%.1f]x[%.1f,%.1f]x[%.1f,%.1f] mm, %.0f simulated s\n",
-              o.tables_path.empty() ? "the baked-in hex prism" : o.tables_path.c_str(),
-              o.operator_path.empty() ? o.pattern_name.c_str() : o.operator_path.c_str(), job.stock.low_mm.x(),
+  const std::string motion = !o.gcode_operator_path.empty() ? "the G-code program " + o.gcode_operator_path
+                             : o.operator_path.empty()      ? o.pattern_name + " pattern"
+                                                            : o.operator_path + " pattern";
+  std::printf("stencil-sim: %s, %s over the stock [%.1f,%.1f]x[%.1f,%.1f]x[%.1f,%.1f] mm, %.0f simulated s\n",
+              o.tables_path.empty() ? "the baked-in hex prism" : o.tables_path.c_str(), motion.c_str(), job.stock.low_mm.x(),
               job.stock.high_mm.x(), job.stock.low_mm.y(), job.stock.high_mm.y(), job.stock.low_mm.z(),
               job.stock.high_mm.z(), job.script.duration_s());
   std::fflush(stdout);
