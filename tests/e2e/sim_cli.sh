@@ -53,7 +53,8 @@ json_number() {
 
 # at_most VALUE LIMIT WHAT
 at_most() {
-  awk -v v="$1" -v l="$2" 'BEGIN { exit !(v != "null" && v + 0 <= l + 0) }' || fail "$3 is $1; expected at most $2"
+  # A number at most l: empty or null (nothing measured) fails.
+  awk -v v="$1" -v l="$2" 'BEGIN { exit !(v ~ /^-?[0-9.]+([eE][-+]?[0-9]+)?$/ && v + 0 <= l + 0) }' || fail "$3 is '$1'; expected at most $2"
 }
 
 # journal_holds_everything JOURNAL REPORT EVENTS WHAT: read back with stencil-journal (the
