@@ -251,6 +251,12 @@ class CanonicalReader {
     return true;
   }
 
+  // rs274 prints tool numbers as integers; anything else is not its output (and would not convert).
+  bool tool_number(const CanonicalCall& call) {
+    if (numbers_[0] >= 0.0 && numbers_[0] <= 1e9 && numbers_[0] == std::round(numbers_[0])) return true;
+    return fail(call, "a tool number that is not a whole number from 0 (" + printable(call.arguments) + ")");
+  }
+
   bool all_zero(std::size_t from) const {
     return std::all_of(numbers_.begin() + static_cast<std::ptrdiff_t>(from), numbers_.end(),
                        [](double v) { return v == 0.0; });
@@ -327,7 +333,7 @@ class CanonicalReader {
       return true;
     }
     if (name == "SELECT_TOOL") {
-      if (!numbers(call, 1, 1)) return false;
+      if (!numbers(call, 1, 1) || !tool_number(call)) return false;
       if (program_.moves.empty()) program_.tool = "T" + std::to_string(static_cast<long long>(numbers_[0]));
       return true;
     }
@@ -337,7 +343,7 @@ class CanonicalReader {
       // was not made for.
       if (!program_.moves.empty()) return refuse(call, "a tool change after the first move (M6/M61)");
       if (name == "CHANGE_TOOL_NUMBER") {
-        if (!numbers(call, 1, 1)) return false;
+        if (!numbers(call, 1, 1) || !tool_number(call)) return false;
         program_.tool = "T" + std::to_string(static_cast<long long>(numbers_[0]));
       }
       return true;

@@ -49,7 +49,11 @@ inline constexpr const char* kGcodeBlockMarker = "@";
 // Gives every line of `source` the word N<its line number> (an existing N word is replaced, after a
 // block-delete '/' if there is one) and the block marker comment as its last comment (before a ';'
 // comment); '%' lines are kept as they are, a CR before the newline is dropped. rs274 prints each
-// canonical call with the N word of the block that made it, and names it in its errors.
+// canonical call with the N word of the block that made it, and names it in its errors. The words
+// added make a line about 10 characters longer: a line already near rs274's 255-character limit
+// becomes its error "Command too long", named by its line. Only the marker comment of a line is
+// executed (rs274 runs only the last comment): a (MSG, ...) or (DEBUG, ...) there is not shown.
+// Large line numbers are fine (N1234567 tested: rs274 takes and prints them whole).
 [[nodiscard]] std::string number_blocks(const std::string& source);
 
 // Reads rs274's canonical calls (`-g` batch output) into moves. False with `error` naming the source

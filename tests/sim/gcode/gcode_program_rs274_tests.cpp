@@ -201,6 +201,16 @@ TEST(ReadGcodeProgram, FollowsALoopWhoseBodyIsOneLine) {
   check_vector({3, 2, 0}, program.moves[4].to_mm, 0.0);
 }
 
+TEST(ReadGcodeProgram, RefusesAProgramThatMakesNoMove) {
+  STRCMP_EQUAL((path + ": the program makes no move").c_str(), read_error("G21 F100\nM2\n").c_str());
+}
+
+TEST(ReadGcodeProgram, RefusesAnEmptyFile) {
+  // No block to name: rs274's own words, with its exit status.
+  STRCMP_EQUAL((path + ": rs274 failed (exit status 1): File ended with no percent sign").c_str(),
+               read_error("").c_str());
+}
+
 TEST(ReadGcodeProgram, ReportsAMissingInterpreter) {
   GcodeReadOptions options;
   options.rs274 = "/nonexistent/rs274";

@@ -309,6 +309,15 @@ TEST(ParseCanonical, RecordsTheToolLoadedBeforeTheFirstMove) {
   STRCMP_EQUAL("T3", program.tool.c_str());
 }
 
+TEST(ParseCanonical, RefusesAToolNumberThatIsNotAWholeNumber) {
+  for (const char* number : {"1.5", "-1", "1e300"}) {
+    Canon canon;
+    canon.call(4, std::string("SELECT_TOOL(") + number + ")");
+    const std::string error = parse_error(canon.text());
+    CHECK_TEXT(starts_with(error, "line 4: a tool number that is not a whole number"), error.c_str());
+  }
+}
+
 TEST(ParseCanonical, RefusesAToolChangeAfterTheFirstMoveNamingItsLine) {
   Canon canon;
   canon.call(2, "STRAIGHT_TRAVERSE(0.0000, 0.0000, 5.0000, 0.0000, 0.0000, 0.0000)")
