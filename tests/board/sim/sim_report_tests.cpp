@@ -94,6 +94,28 @@ TEST(SimReport, TheFaultTheJournalAndTheMillAfterTheStopAreReported) {
   DOUBLES_EQUAL(13.0, report["job"]["total_simulated_s"].get<double>(), 0.0);
 }
 
+TEST(SimReport, AGcodeProgramsRefusedLinesAreInTheReportAndTheSummaryAndOtherwiseNothingIs) {
+  const TempPath file;
+  std::string error;
+  SimResult plain;
+  CHECK_TRUE(write_report_json(file.path, plain, report::Provenance{}, error));
+  CHECK_FALSE(nlohmann::json::parse(read_text(file.path)).contains("gcode"));  // every other job's report as before
+  SimResult guarded;
+  guarded.gcode_program = "cam.ngc";
+  guarded.gcode_refused = {{11, 0.5}, {14, 0.25}};
+  CHECK_TRUE(write_report_json(file.path, guarded, report::Provenance{}, error));
+  const nlohmann::json report = nlohmann::json::parse(read_text(file.path));
+  STRCMP_EQUAL("operator", report["gcode"]["run"].get<std::string>().c_str());
+  LONGS_EQUAL(2, report["gcode"]["refused"].size());
+  LONGS_EQUAL(14, report["gcode"]["refused"][1]["line"].get<int>());
+  DOUBLES_EQUAL(0.25, report["gcode"]["refused"][1]["depth_mm"].get<double>(), 0.0);
+  CHECK(summary(guarded).find("gcode: 2 lines of cam.ngc refused or shortened by the stencil: line 11 (0.500 mm deep) "
+                              "line 14 (0.250 mm deep)") != std::string::npos);
+  guarded.gcode_direct = true;
+  CHECK_TRUE(write_report_json(file.path, guarded, report::Provenance{}, error));
+  CHECK_TRUE(nlohmann::json::parse(read_text(file.path))["gcode"]["refused"].is_null());
+}
+
 TEST(SimReport, TheStockCsvIsOneRowALineWithYRising) {
   SimResult result;
   result.columns = 3;
