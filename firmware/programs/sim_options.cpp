@@ -200,6 +200,9 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
   } else if (o.fast == (o.speed > 0.0)) {
     error = o.fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)";
   }
+  if (!o.gcode_direct_path.empty()) {
+    o.no_journal = true;  // no controller, nothing to record: the report and the stock are the result
+  }
   return error.empty();
 }
 

@@ -160,6 +160,36 @@ TEST(SimOptions, ABadMillTruthFileIsNamedAsThat) {
   CHECK_EQUAL(0U, error.find("--mill-truth: "));
 }
 
+// G-code: a program as the operator is one motion among the others; cut directly it has no controller,
+// so nothing that needs one goes with it; the export is written from the journal.
+TEST(SimOptions, GcodeOptionsThatCannotGoTogetherAreRefusedNamingThem) {
+  const Checked both({"--fast", "--operator", "a.csv", "--gcode-operator", "a.ngc"});
+  CHECK_FALSE(both.ok);
+  STRCMP_CONTAINS("--operator and --gcode-operator: choose one", both.error.c_str());
+  for (const std::vector<std::string>& words : std::vector<std::vector<std::string>>{
+           {"--gcode-direct", "a.ngc", "--gcode-operator", "b.ngc"},
+           {"--gcode-direct", "a.ngc", "--gcode", "b.ngc"},
+           {"--gcode-direct", "a.ngc", "--journal", "j.journal"},
+           {"--gcode-direct", "a.ngc", "--inject", "pose-nan@1"}}) {
+    const Checked c(words);
+    CHECK_FALSE(c.ok);
+    STRCMP_CONTAINS("--gcode-direct cuts the program with no controller", c.error.c_str());
+  }
+  const Checked no_journal({"--fast", "--no-journal", "--gcode", "cut.ngc"});
+  CHECK_FALSE(no_journal.ok);
+  STRCMP_CONTAINS("--gcode writes the program from the job's journal", no_journal.error.c_str());
+}
+
+TEST(SimOptions, GcodeDirectNeedsNoClockAndKeepsNoJournal) {
+  const Checked c({"--gcode-direct", "a.ngc"});
+  CHECK_TRUE(c.ok);
+  CHECK_TRUE(c.options.fast);
+  CHECK_TRUE(c.options.no_journal);
+  const Checked guard({"--fast", "--gcode-operator", "a.ngc", "--gcode", "cut.ngc"});
+  CHECK_TRUE(guard.ok);
+  CHECK_FALSE(guard.options.no_journal);
+}
+
 // --linuxcnc-samples is the ground truth of a LinuxCNC mill: refused, named, with a CY545 rig (the
 // compiled-in one here). The LinuxCNC configuration's own refusals (no --speed 1, no samples, a
 // simulated mill's options) run end to end in e2e.linuxcnc_*.
