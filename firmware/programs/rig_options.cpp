@@ -73,6 +73,9 @@ void add_record_options(CLI::App& app, RigOptions& o) {
                  "record the job here: every cycle's sample, virtual tool and force, every machine command (written "
                  "before it is sent), every safe-state event; used as given (default: job.journal in the job's folder)");
   app.add_flag("--no-journal", o.no_journal, "record no journal (the job cannot be resumed)");
+  app.add_option("--gcode", o.gcode_path,
+                 "at the end, write the path the mill was commanded as a G-code program any CNC can run (as "
+                 "stencil-journal gcode writes it from the job's journal: mm, absolute, work coordinates, G61)");
   add_job_folder_options(app, o.jobs, "stencil-rig", "job.journal and report.json, checked before anything moves",
                          "A --resume writes in its journal's folder");
   app.add_option("--resume", o.resume_path,
@@ -149,6 +152,10 @@ bool check_rig_options(const RigOptions& o, board::sherline_suzuki::WorkOffset& 
   }
   if (!board::sherline_suzuki::is_haptic_link_name(o.haptic)) {
     error = "--haptic " + o.haptic + ": expected pio:/dev/uioN or can:IFACE";
+    return false;
+  }
+  if (!o.gcode_path.empty() && o.no_journal) {
+    error = "--gcode writes the program from the job's journal: not with --no-journal";
     return false;
   }
   if (!o.resume_path.empty() && (!o.journal_path.empty() || o.no_journal)) {

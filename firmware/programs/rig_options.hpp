@@ -33,6 +33,7 @@ struct RigOptions {
   double reference_stick_out = 0.0;
   std::string stock_text;     // empty: the whole workspace
   std::string report_path;    // empty: report.json in the job's folder (a --resume's report-resume-N.json)
+  std::string gcode_path;     // --gcode: the cut written as a G-code program at the end (from the journal)
   std::string journal_path;   // empty: job.journal in the job's folder
   JobFolderOptions jobs;      // --out-dir, --keep-jobs, --keep-mb
   bool no_journal = false;

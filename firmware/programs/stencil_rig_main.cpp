@@ -28,6 +28,7 @@
 #include "firmware/runtime/realtime_thread.hpp"
 #include "firmware/runtime/rt_readiness.hpp"
 #include "firmware/services/display_link/display_link.hpp"
+#include "firmware/services/gcode/journal_gcode.hpp"
 #include "firmware/services/journal/job_history.hpp"
 #include "firmware/services/journal/job_journal.hpp"
 #include "firmware/services/journal/journal_writer.hpp"
@@ -212,6 +213,27 @@ void print_summary(const RigResult& result) {
               static_cast<unsigned long long>(result.resets_accepted), static_cast<unsigned long long>(result.resets_refused));
 }
 
+// --gcode: the program from the journal just closed, as stencil-journal gcode writes it (the job's own
+// touch-off is in the journal's record of the job). A failure is said; the cut stands in the journal.
+bool write_gcode(const app::RigOptions& o, const board::sherline_suzuki::RigJob& job, const tables::PartTables& part,
+                 const std::string& journal_path, std::string& error) {
+  gcode::JournalExport settings;
+  const motion::PlannerLimits limits = board::sherline_suzuki::planner_limits(job.facts);
+  settings.path.path = limits.path;
+  settings.path.update_s = limits.update_period_s;
+  settings.path.home_world_mm = board::sherline_suzuki::rig_frames(job.offset, job.facts).home_world_mm;
+  settings.program.safe_z_mm = settings.path.home_world_mm.z();
+  settings.source_name = journal_path;
+  settings.config_crc32 = o.config.file_crc32;
+  gcode::ExportSummary summary;
+  if (!gcode::export_journal_gcode(journal_path, part, settings, o.gcode_path, summary, error)) {
+    return false;
+  }
+  std::printf("gcode: %s (%llu moves from %llu machine targets)\n", o.gcode_path.c_str(),
+              static_cast<unsigned long long>(summary.moves), static_cast<unsigned long long>(summary.targets));
+  return true;
+}
+
 // After the run: what it did, said at the terminal and in the report. The program's exit status.
 int finish(const app::RigOptions& o, const RigResult& result, const char* link_error, bool journal_closed,
            const journal::JournalWriter& journal_writer) {
@@ -388,6 +410,9 @@ int main(int argc, char** argv) {
     folder.abandon();
     const std::string link_error = devices.machine_error();
     return fail(kExitNotStarted, result.error + (link_error.empty() ? "" : ": " + link_error));
+  }
+  if (!o.gcode_path.empty() && journal_closed && !write_gcode(o, job, part, journal_path, error)) {
+    std::fprintf(stderr, "stencil-rig: --gcode: %s\n", error.c_str());
   }
   return finish(o, result, devices.machine_error(), journal_closed, journal_writer);
 }

@@ -5,6 +5,7 @@ LinuxCNC's homing, then AUTO mode, open, run, and wait until the program has end
 printed. Exit 0 when the program ran to its end with no error, 1 otherwise.
 
 usage: linuxcnc_program.py PROGRAM [--port 5007] [--connectpw PW] [--enablepw PW] [--timeout S]
+       [--feed-override PERCENT]
 """
 import argparse
 import socket
@@ -64,6 +65,8 @@ def main():
     parser.add_argument("--connectpw", default="SimMillHello")
     parser.add_argument("--enablepw", default="SimMillEnable")
     parser.add_argument("--timeout", type=float, default=600.0, help="seconds the program may run")
+    parser.add_argument("--feed-override", type=int, default=100,
+                        help="percent (a measurement's shortcut: within the INI's MAX_FEED_OVERRIDE)")
     args = parser.parse_args()
     rsh = Rsh(args.port, 10.0)
     rsh.ask(f"hello {args.connectpw} stencil-e2e 1.1", "HELLO ACK")
@@ -87,6 +90,8 @@ def main():
         time.sleep(0.2)
     rsh.set("mode auto", "MODE")
     rsh.set(f"open {args.program}", "OPEN")
+    if args.feed_override != 100:
+        rsh.set(f"feed_override {args.feed_override}", "FEED_OVERRIDE")
     started = time.monotonic()
     rsh.set("run", "RUN")
     status = ""

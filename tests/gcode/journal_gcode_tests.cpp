@@ -119,6 +119,18 @@ TEST(JournalGcode, AnotherRigsJobIsRefusedNamingTheConfiguration) {
   CHECK_TEXT(gcode::export_journal_gcode(f.journal.path, f.part, configured, f.out, summary, error), error.c_str());
 }
 
+TEST(JournalGcode, ARigJobsRecordedTouchOffIsItsHome) {
+  Fixture f;
+  f.write({{39.0, 20.0, 19.0}}, f.part.header.crc32,
+          "work-offset=40.000000,20.000000,20.000000 tool-stick-out=1.500000 reference-stick-out=0.500000 "
+          "stock=0,0,0,50,25,25 config=compiled-in");
+  gcode::ExportSummary summary;
+  std::string error;
+  CHECK_TEXT(gcode::export_journal_gcode(f.journal.path, f.part, f.settings(), f.out, summary, error), error.c_str());
+  // Home: the offset, its tip 1 mm lower for a tool sticking out 1 mm more than the touch-off's.
+  CHECK(f.program().find("G0 Z19\nG0 X40 Y20\nG1 X39 F600\nG0 Z19\n") != std::string::npos);
+}
+
 TEST(JournalGcode, AJobThatNeverMovedTheMillWritesNoProgram) {
   Fixture f;
   f.write({}, f.part.header.crc32);

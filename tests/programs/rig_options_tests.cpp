@@ -56,6 +56,19 @@ TEST(RigOptions, AJobWithoutAFileNeedsTablesSerialAndHaptic) {
   CHECK_TRUE(all.apply());
 }
 
+TEST(RigOptions, TheGcodeExportNeedsTheJournal) {
+  board::sherline_suzuki::WorkOffset offset;
+  control::StockBlock stock{};
+  Parsed without(job_with({"--gcode", "cut.ngc", "--no-journal"}));
+  CHECK_TRUE(without.apply());
+  CHECK_FALSE(without.check(offset, stock));
+  STRCMP_CONTAINS("--gcode writes the program from the job's journal", without.error.c_str());
+  Parsed with(job_with({"--gcode", "cut.ngc"}));
+  CHECK_TRUE(with.apply());
+  CHECK_TRUE_TEXT(with.check(offset, stock), with.error.c_str());
+  STRCMP_EQUAL("cut.ngc", with.options.gcode_path.c_str());
+}
+
 TEST(RigOptions, CommissioningNeedsOnlyTheSerialPort) {
   Parsed c({"--commission", "--serial", "/dev/ttyS0"});
   CHECK_TRUE(c.apply());

@@ -3,6 +3,7 @@
 #include <cinttypes>
 #include <cstdio>
 #include <cstdlib>
+#include <optional>
 
 #include "firmware/core/geometry/tool_spec.hpp"
 #include "firmware/services/journal/journal_reader.hpp"
@@ -21,7 +22,7 @@ std::string tool_name(const tables::PartTables& part) {
 
 bool export_journal_gcode(const std::string& journal_path, const tables::PartTables& part, JournalExport settings,
                           const std::string& out_path, ExportSummary& summary, std::string& error) {
-  CutPath path(settings.path);
+  std::optional<CutPath> path;
   bool tables_match = true;
   std::uint32_t job_config_crc32 = 0;
   bool started = false;
@@ -35,13 +36,30 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
     if (at != std::string::npos) {
       job_config_crc32 = static_cast<std::uint32_t>(std::strtoul(start.job.c_str() + at + 13, nullptr, 16));
     }
+    // stencil-rig records the job's touch-off (its work offset and the tool's stick-out): the tool's
+    // tip at home is there, whatever the configuration's default.
+    double x = 0.0, y = 0.0, z = 0.0, stick_out = 0.0, reference = 0.0;
+    const std::size_t offset = start.job.find("work-offset=");
+    if (!path && offset != std::string::npos &&
+        std::sscanf(start.job.c_str() + offset, "work-offset=%lf,%lf,%lf tool-stick-out=%lf reference-stick-out=%lf", &x, &y,
+                    &z, &stick_out, &reference) == 5) {
+      settings.path.home_world_mm = {x, y, z - (stick_out - reference)};
+      settings.program.safe_z_mm = settings.path.home_world_mm.z();
+    }
+    if (!path) {
+      path.emplace(settings.path);
+    }
   };
   visit.homed = [&](std::int64_t) {
-    path.homed();
+    if (!path) {
+      return;  // before any start: the reader refuses such a journal
+    }
+    path->homed();
     ++summary.homings;
   };
   visit.machine_command = [&](const control::MachineCommandRecord& record) {
-    if (command_error.empty() && !path.command(record, command_error)) {
+    if (command_error.empty() && (!path || !path->command(record, command_error))) {
+      command_error = command_error.empty() ? "a machine target before the job's start record" : command_error;
       command_error = journal_path + ": " + command_error;
     }
   };
@@ -50,7 +68,7 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
     error = read.error;
     return false;
   }
-  if (!started) {
+  if (!started || !path) {
     error = journal_path + ": no job's start record: not a job's journal";
     return false;
   }
@@ -74,13 +92,13 @@ bool export_journal_gcode(const std::string& journal_path, const tables::PartTab
     error = command_error;
     return false;
   }
-  if (path.targets() == 0) {
+  if (path->targets() == 0) {
     error = journal_path + ": the mill was given no target: nothing was cut, no program to write";
     return false;
   }
-  summary.targets = path.targets();
-  summary.legs = path.moves().size();
-  const MergeResult merged = merge_collinear(path.moves(), settings.path.home_world_mm, part, settings.merge_tolerance_mm);
+  summary.targets = path->targets();
+  summary.legs = path->moves().size();
+  const MergeResult merged = merge_collinear(path->moves(), settings.path.home_world_mm, part, settings.merge_tolerance_mm);
   summary.moves = merged.moves.size();
   summary.sweep_checks = merged.sweep_checks;
   Eigen::Vector3d at = settings.path.home_world_mm;
