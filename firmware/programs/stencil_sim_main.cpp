@@ -453,10 +453,24 @@ board::sim::SimResult run(const app::SimOptions& o, board::sim::SimJob& job) {
 
 // After the run: the journal ended in order (or, when nothing ran, every output of this run undone),
 // the summary, the report, the picture and the stock's heights. The program's exit status.
+// The report, its picture and (when asked) the stock's heights; said where they went. False with
+// `error` naming what could not be written.
+bool write_outputs(const app::SimOptions& o, const board::sim::SimResult& result, const report::Provenance& provenance,
+                   std::string& error) {
+  const std::string picture_path = picture_path_of(o.report_path);
+  if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
+      !board::sim::write_picture_png(picture_path, result, error) ||
+      (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
+    return false;
+  }
+  std::printf("report: %s\npicture: %s\n", o.report_path.c_str(), picture_path.c_str());
+  return true;
+}
+
 // --gcode-direct: the program's moves cut into the stock with no controller; the report, picture and
 // stock heights as a job's, in the job's folder.
 int cut_directly(app::SimOptions& o, const tables::PartTables& part, const board::sim::SimJob& job,
-                 const sim::GcodeProgram& program) {
+                 const sim::GcodeProgram& program, const report::Provenance& provenance) {
   std::string error;
   report::JobFolder folder;
   if (!place_outputs(o, 0, folder, error)) {
@@ -468,23 +482,11 @@ int cut_directly(app::SimOptions& o, const tables::PartTables& part, const board
   result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
   result.gcode_program = o.gcode_direct_path;
   result.gcode_direct = true;
-  report::Provenance provenance;
-  provenance.program = "stencil-sim";
-  provenance.tables = o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path;
-  provenance.tables_crc32 = part.header.crc32;
-  provenance.triangle_count = part.header.triangle_count;
   std::printf("gcode-direct: %s, %zu moves cut with no stencil\n", o.gcode_direct_path.c_str(), program.moves.size());
   std::printf("gouge: %s mm deepest, %.3f mm3 under the part's top\nstock removed %.1f mm3\n",
               result.gouge_measured ? std::to_string(result.gouge_max_depth_mm).c_str() : "not measured (not a ball end mill)",
               result.gouge_volume_mm3, result.removed_volume_mm3);
-  const std::string picture_path = picture_path_of(o.report_path);
-  if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
-      !board::sim::write_picture_png(picture_path, result, error) ||
-      (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
-    return bad_input(error);
-  }
-  std::printf("report: %s\npicture: %s\n", o.report_path.c_str(), picture_path.c_str());
-  return kExitDone;
+  return write_outputs(o, result, provenance, error) ? kExitDone : bad_input(error);
 }
 
 // --gcode: the program from the journal just closed, as stencil-journal gcode writes it.
@@ -533,13 +535,9 @@ int finish(const app::SimOptions& o, const tables::PartTables& part, board::sim:
     result.journal_error = closed ? "" : journal_writer.error();
   }
   std::printf("%s", board::sim::summary(result).c_str());
-  const std::string picture_path = picture_path_of(o.report_path);
-  if (!board::sim::write_report_json(o.report_path, result, provenance, error) ||
-      !board::sim::write_picture_png(picture_path, result, error) ||
-      (!o.stock_csv_path.empty() && !board::sim::write_stock_csv(o.stock_csv_path, result, error))) {
+  if (!write_outputs(o, result, provenance, error)) {
     return bad_input(error);
   }
-  std::printf("report: %s\npicture: %s\n", o.report_path.c_str(), picture_path.c_str());
   if (!o.gcode_path.empty() && !write_gcode(o, part, journal_path, error)) {
     return bad_input("--gcode: " + error);
   }
@@ -588,9 +586,6 @@ int main(int argc, char** argv) {
   if (o.commission) {
     return commission(o, job);
   }
-  if (!o.gcode_direct_path.empty()) {
-    return cut_directly(o, part, job, program);
-  }
   report::Provenance provenance;
   provenance.program = "stencil-sim";
   provenance.command_line.assign(argv, argv + argc);
@@ -599,6 +594,9 @@ int main(int argc, char** argv) {
   provenance.tables = o.tables_path.empty() ? std::string("(baked-in hex prism)") : o.tables_path;
   provenance.tables_crc32 = part.header.crc32;
   provenance.triangle_count = part.header.triangle_count;
+  if (!o.gcode_direct_path.empty()) {
+    return cut_directly(o, part, job, program, provenance);
+  }
   report::JobFolder folder;
   if (!o.replay_path.empty()) {
     return place_outputs(o, 0, folder, error)
