@@ -30,7 +30,7 @@ Usage: $PROG [options] COMMAND DIR [ARGS]
 Runs the simulated 3-axis mill (X 0..50, Y 0..25, Z 0..25 mm; 5 mm/s, 50 mm/s^2 per axis) under
 the real LinuxCNC (uspace, 1 ms servo thread), headless, with linuxcncrsh as its only interface.
 DIR is the instance's folder: the config is copied there and everything LinuxCNC writes goes there
-(HOME=DIR). Only one LinuxCNC can run on a host.
+(HOME=DIR; rtapi_app's socket in /tmp/lcnc-sim-UID, short enough for any DIR). Only one LinuxCNC can run on a host.
 
 Commands:
   start DIR      Copy the config to DIR (created if missing; an old instance's files there are
@@ -123,14 +123,29 @@ else
     AS_USER=(setpriv --no-new-privs)
 fi
 
+# rtapi_app's socket is a unix socket: its path must fit in 108 bytes, which DIR/.rtapi_fifo does
+# not in a deep build tree (a CI checkout's test folder). It lives in a short folder of its own,
+# one per user (only one LinuxCNC runs on a host anyway).
+FIFO_DIR="/tmp/lcnc-sim-$RUN_UID"
+FIFO="$FIFO_DIR/rtapi_fifo"
+fifo_dir_ready() {
+    if [ -L "$FIFO_DIR" ] || { [ -e "$FIFO_DIR" ] && [ ! -d "$FIFO_DIR" ]; }; then
+        die "$FIFO_DIR is not a plain folder: remove it (rtapi_app's socket goes there)"
+    fi
+    mkdir -p -m 700 "$FIFO_DIR" 2>/dev/null || die "cannot create $FIFO_DIR for rtapi_app's socket"
+    [ "$(id -u)" != 0 ] || chown "$RUN_UID:$RUN_GID" "$FIFO_DIR" || die "cannot chown $FIFO_DIR to $SIM_USER"
+    [ "$(stat -c %u "$FIFO_DIR")" = "$RUN_UID" ] || die "$FIFO_DIR belongs to another user: remove it"
+    chmod 700 "$FIFO_DIR"
+}
+
 # Every process of the instance carries LCNC_SIM_DIR=DIR in its environment: that is how stop and
 # kill find them (rtapi_app and linuxcncsvr start their own sessions, so a process group is not
 # enough), and nothing else on the host is touched.
 run_env() {
-    env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" LANG=C.UTF-8 LC_ALL=C.UTF-8 \
+    env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" LANG=C.UTF-8 LC_ALL=C.UTF-8 \
         USER="$SIM_USER" LOGNAME="$SIM_USER" TMPDIR="$DIR" LCNC_SIM_DIR="$DIR" "$@"
 }
-as_user() { "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" LANG=C.UTF-8 \
+as_user() { "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" LANG=C.UTF-8 \
     LC_ALL=C.UTF-8 USER="$SIM_USER" LOGNAME="$SIM_USER" TMPDIR="$DIR" LCNC_SIM_DIR="$DIR" "$@"; }
 
 instance_pids() {   # live (non-zombie) processes whose environment holds LCNC_SIM_DIR=$DIR
@@ -162,7 +177,7 @@ cleanup_host_state() {
     # the linuxcnc script's temp logs (it removes them itself unless killed)
     find /tmp -maxdepth 1 \( -name 'linuxcnc.debug.*' -o -name 'linuxcnc.print.*' \) \
         -uid "$RUN_UID" -delete 2>/dev/null || true
-    rm -f "$DIR/.rtapi_fifo" 2>/dev/null || true
+    rm -f "$DIR/.rtapi_fifo" "$FIFO" 2>/dev/null || true
 }
 
 hello_ok() {   # one hello on the port; true if HELLO ACK comes back within 2 s
@@ -223,10 +238,11 @@ cmd_start() {
         chown -R "$RUN_UID:$RUN_GID" "$DIR" || die "cannot chown $DIR to $SIM_USER"
     fi
     chmod 700 "$DIR"
+    fifo_dir_ready
     as_user test -w "$DIR" -a -x "$DIR" || die "$SIM_USER cannot write $DIR (is a parent folder closed to it?)"
 
     # LinuxCNC: the linuxcnc script, -r keeps its output in our log (no tty, no X)
-    ( cd "$DIR" && exec setsid "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" \
+    ( cd "$DIR" && exec setsid "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" \
         LANG=C.UTF-8 LC_ALL=C.UTF-8 USER="$SIM_USER" LOGNAME="$SIM_USER" TMPDIR="$DIR" \
         LCNC_SIM_DIR="$DIR" linuxcnc -r "$DIR/mill.ini" ) > "$DIR/linuxcnc.log" 2>&1 < /dev/null &
     local lpid=$!
@@ -255,7 +271,7 @@ cmd_start() {
 
     # ground truth recorder (the sampler FIFO holds 30 s, so nothing since the servo thread
     # started is lost)
-    ( cd "$DIR" && exec setsid "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" \
+    ( cd "$DIR" && exec setsid "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" \
         LANG=C.UTF-8 LC_ALL=C.UTF-8 LCNC_SIM_DIR="$DIR" halsampler -t "$DIR/samples.txt" ) \
         > "$DIR/halsampler.log" 2>&1 < /dev/null &
     local spid=$!
