@@ -141,10 +141,6 @@ fifo_dir_ready() {
 # Every process of the instance carries LCNC_SIM_DIR=DIR in its environment: that is how stop and
 # kill find them (rtapi_app and linuxcncsvr start their own sessions, so a process group is not
 # enough), and nothing else on the host is touched.
-run_env() {
-    env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" LANG=C.UTF-8 LC_ALL=C.UTF-8 \
-        USER="$SIM_USER" LOGNAME="$SIM_USER" TMPDIR="$DIR" LCNC_SIM_DIR="$DIR" "$@"
-}
 as_user() { "${AS_USER[@]}" env -i PATH=/usr/sbin:/usr/bin:/sbin:/bin HOME="$DIR" RTAPI_FIFO_PATH="$FIFO" LANG=C.UTF-8 \
     LC_ALL=C.UTF-8 USER="$SIM_USER" LOGNAME="$SIM_USER" TMPDIR="$DIR" LCNC_SIM_DIR="$DIR" "$@"; }
 
