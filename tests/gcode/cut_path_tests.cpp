@@ -105,6 +105,18 @@ TEST(CutPath, ATargetBeforeHomingOrNotFiniteIsRefusedNamingIt) {
   LONGS_EQUAL(0, path.moves().size());
 }
 
+TEST(CutPath, AStaircaseOrderThatLeavesOutAMovingAxisIsRefusedNamingTheTarget) {
+  CutPath path = staircase();
+  std::string error;
+  // Y moves, but the order is X, Z, none: no staircase the mill can have moved.
+  const control::MachineCommandRecord record = target(49.0, 24.0, 25.0, 0, 2, 3);
+  CHECK_FALSE(path.command(record, error));
+  CHECK(error.find("machine target " + std::to_string(record.update)) != std::string::npos);
+  CHECK(error.find("leaves out") != std::string::npos);
+  LONGS_EQUAL(0, path.moves().size());
+  LONGS_EQUAL(0, path.targets());
+}
+
 namespace {
 
 struct Part {

@@ -36,15 +36,8 @@ bool CutPath::command(const control::MachineCommandRecord& record, std::string& 
     error = "machine target " + std::to_string(record.update) + " comes before the machine was homed";
     return false;
   }
-  ++targets_;
-  if (target == at_) {
-    return true;  // a backlash take-up: the motors move, the tool does not
-  }
-  if (settings_.path == motion::MachinePath::Straight) {
-    feed_to(target, settings_.update_s);
-    return true;
-  }
-  // The staircase: one leg per axis that moves, in the recorded order (3: no leg).
+  // The staircase: one leg per axis that moves, in the recorded order (3: no leg). An order that
+  // leaves out an axis that moves is not a path the mill can have taken: refused, not guessed at.
   Eigen::Vector3d corner = at_;
   double total = 0.0;
   for (const std::uint8_t axis : record.order) {
@@ -53,6 +46,19 @@ bool CutPath::command(const control::MachineCommandRecord& record, std::string& 
       corner[axis] = target[axis];
     }
   }
+  if (settings_.path == motion::MachinePath::Staircase && corner != target) {
+    error = "machine target " + std::to_string(record.update) +
+            " moves an axis its recorded leg order leaves out: not a staircase the mill can have moved";
+    return false;
+  }
+  ++targets_;
+  if (target == at_) {
+    return true;  // a backlash take-up: the motors move, the tool does not
+  }
+  if (settings_.path == motion::MachinePath::Straight) {
+    feed_to(target, settings_.update_s);
+    return true;
+  }
   corner = at_;
   for (const std::uint8_t axis : record.order) {
     if (axis < 3 && corner[axis] != target[axis]) {
@@ -60,11 +66,6 @@ bool CutPath::command(const control::MachineCommandRecord& record, std::string& 
       corner[axis] = target[axis];
       feed_to(corner, settings_.update_s * length / total);
     }
-  }
-  if (corner != target) {
-    // An order that leaves an axis out (not what the planner records): straight on to the target,
-    // so the path still ends where the mill did.
-    feed_to(target, settings_.update_s);
   }
   return true;
 }
