@@ -126,7 +126,7 @@ case_exported_program_cuts_the_same_stock_on_linuxcnc() {
     --stock-csv "$work/lcnc.csv" > direct.txt 2>&1 || { cat direct.txt >&2; fail "the samples' cut failed"; return; }
   # Within 0.01 mm in 3-D: where the heights differ by more, the distance from the lower surface to
   # the other path's tool envelope (stock_surface_distance.py says why heights alone are not it).
-  "$journal_tool" gcode jobs/latest/job.journal -o job-work.ngc > gcode-work.txt 2>&1 ||
+  "$journal_tool" gcode jobs/latest/job.journal -o job-work.ngc --merge-tolerance 0 > gcode-work.txt 2>&1 ||
     { cat gcode-work.txt >&2; fail "stencil-journal gcode (work frame) failed"; return; }
   difference=$(python3 "$source_dir/tests/e2e/stock_difference.py" job.csv lcnc.csv) || fail "the stocks could not be compared"
   local apart

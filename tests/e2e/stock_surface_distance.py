@@ -43,20 +43,27 @@ def heights(path):
         fail(f"{path}: {error}")
 
 
+# Words that change what X/Y/Z mean, or moves that are not straight: this measure follows none of
+# them (our exported programs and samples_to_gcode.py's use none), so a program with one is refused.
+UNFOLLOWED = {"G2", "G02", "G3", "G03", "G20", "G91", "G53", "G92", "G10", "G28", "G30", "G38.2", "G43", "G55", "G56",
+              "G57", "G58", "G59"}
+
+
 def path_points(path):
-    """The tip's positions through the program's straight moves (modal X/Y/Z words, G0/G1 only)."""
+    """The tip's positions through the program's straight moves (G0/G1, absolute mm, modal X/Y/Z)."""
     at, points = [None, None, None], []
     try:
         with open(path) as program:
             for number, line in enumerate(program, 1):
-                code = line.split(";")[0]
-                while "(" in code:
+                code = line
+                while "(" in code:  # a comment first: a ';' inside one is its text
                     start = code.index("(")
                     end = code.find(")", start)
-                    code = code[:start] + ("" if end < 0 else code[end + 1:])
-                words = code.upper().split()
-                if any(w in ("G2", "G02", "G3", "G03") for w in words):
-                    fail(f"{path}: line {number}: an arc; this measure follows straight moves only")
+                    code = code[:start] + " " + ("" if end < 0 else code[end + 1:])
+                words = code.split(";")[0].upper().split()
+                refused = [w for w in words if w in UNFOLLOWED]
+                if refused:
+                    fail(f"{path}: line {number}: {refused[0]}; this measure follows straight moves in absolute mm only")
                 moved = False
                 for word in words:
                     if word[:1] in "XYZ" and len(word) > 1:
@@ -92,11 +99,17 @@ for row in range(rows):
             x, y = stock[0] + (column + 0.5) * cell, stock[1] + (row + 0.5) * cell
             # The lower surface's point, measured against the other path's envelope.
             differing.append(((x, y, min(ha, hb)), "b" if ha < hb else "a"))
+paths = {"a": path_points(args.a_ngc), "b": path_points(args.b_ngc)}  # read whatever the stocks say
 if not differing:
     print("0.000000 0")
     sys.exit(0)
 
-BUCKET = 1.0  # mm: segments indexed by the squares of the plane they may reach
+# Segments indexed by the 1 mm squares of the plane their tool may reach, only where a measured point
+# looks: its own square and the eight around it, so every segment whose tool comes within 1 mm of the
+# point in the plane is seen. Farther than that is reported as such, not guessed.
+BUCKET = 1.0
+wanted = {(math.floor(p[0] / BUCKET) + i, math.floor(p[1] / BUCKET) + j)
+          for p, _ in differing for i in (-1, 0, 1) for j in (-1, 0, 1)}
 
 
 def bucketed(points):
@@ -107,7 +120,8 @@ def bucketed(points):
         y0, y1 = min(p[1], q[1]) - radius, max(p[1], q[1]) + radius
         for bx in range(math.floor(x0 / BUCKET), math.floor(x1 / BUCKET) + 1):
             for by in range(math.floor(y0 / BUCKET), math.floor(y1 / BUCKET) + 1):
-                index.setdefault((bx, by), []).append(i)
+                if (bx, by) in wanted:
+                    index.setdefault((bx, by), []).append(i)
     return index
 
 
@@ -124,7 +138,6 @@ def envelope_distance(p, s, e):
     cs, ce = (s[0], s[1], s[2] + radius), (e[0], e[1], e[2] + radius)
     # Split where the centre passes p's height: below p, the shank's cylinder is nearest (distance in
     # the plane); above p, the ball (distance in space).
-    pieces = []
     if (cs[2] - p[2]) * (ce[2] - p[2]) < 0.0:
         t = (p[2] - cs[2]) / (ce[2] - cs[2])
         mid = tuple(cs[k] + t * (ce[k] - cs[k]) for k in range(3))
@@ -133,19 +146,24 @@ def envelope_distance(p, s, e):
         pieces = [(cs, ce)]
     best = math.inf
     for u, v in pieces:
-        if min(u[2], v[2]) <= p[2] and max(u[2], v[2]) <= p[2] + 1e-12:
+        if max(u[2], v[2]) <= p[2] + 1e-12:
             best = min(best, point_segment(p, u, v, 2) - radius)
         else:
             best = min(best, point_segment(p, u, v, 3) - radius)
     return max(0.0, best)
 
 
-paths = {"a": path_points(args.a_ngc), "b": path_points(args.b_ngc)}
 indexes = {name: bucketed(points) for name, points in paths.items()}
 largest = 0.0
 for p, other in differing:
-    points, index = paths[other], indexes[other]
-    candidates = index.get((math.floor(p[0] / BUCKET), math.floor(p[1] / BUCKET)), [])
+    points = paths[other]
+    candidates = set()
+    for i in (-1, 0, 1):
+        for j in (-1, 0, 1):
+            candidates.update(indexes[other].get((math.floor(p[0] / BUCKET) + i, math.floor(p[1] / BUCKET) + j), []))
     nearest = min((envelope_distance(p, points[i], points[i + 1]) for i in candidates), default=math.inf)
+    if nearest == math.inf:
+        print(f"cell at ({p[0]:.3f}, {p[1]:.3f}) mm, height {p[2]:.4f}: the other path's tool never comes within 1 mm of it",
+              file=sys.stderr)
     largest = max(largest, nearest)
 print(f"{largest:.6f} {len(differing)}")
