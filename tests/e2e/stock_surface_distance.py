@@ -18,6 +18,8 @@ import argparse
 import math
 import sys
 
+from stock_difference import grids
+
 parser = argparse.ArgumentParser()
 parser.add_argument("a_csv")
 parser.add_argument("b_csv")
@@ -33,14 +35,6 @@ args = parser.parse_args()
 def fail(message):
     print(message, file=sys.stderr)
     sys.exit(1)
-
-
-def heights(path):
-    try:
-        with open(path) as rows:
-            return [[float(v) for v in row.split(",")] for row in rows if row.strip()]
-    except (OSError, ValueError) as error:
-        fail(f"{path}: {error}")
 
 
 # Words that change what X/Y/Z mean, or moves that are not straight: this measure follows none of
@@ -78,12 +72,13 @@ def path_points(path):
     return points
 
 
-stock = [float(v) for v in args.stock.split(",")]
+try:
+    stock = [float(v) for v in args.stock.split(",")]
+except ValueError:
+    stock = []
 if len(stock) != 6:
     fail(f"--stock '{args.stock}': six numbers X0,Y0,Z0,X1,Y1,Z1 expected")
-a, b = heights(args.a_csv), heights(args.b_csv)
-if len(a) != len(b) or any(len(x) != len(y) for x, y in zip(a, b)):
-    fail(f"{args.a_csv} and {args.b_csv}: grids of different sizes")
+a, b = grids(args.a_csv, args.b_csv)
 rows, columns = len(a), len(a[0])
 width, depth = stock[3] - stock[0], stock[4] - stock[1]
 if columns != max(1, math.ceil(width / args.max_cell)) or rows != max(1, math.ceil(depth / args.max_cell)):
