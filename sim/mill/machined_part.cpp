@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <limits>
 #include <utility>
 
@@ -57,18 +58,21 @@ std::vector<double> lowest_tips(const StockZmap& grid, const std::vector<double>
   const double floor = grid.box().low_mm.z();
   const std::vector<Offset> footprint = footprint_of(grid, tool);
   std::vector<double> tip(part_heights.size(), floor);
+  // A row of cells at a time, each of the footprint's offsets over the whole row: every cell still
+  // takes the maximum over the footprint in the footprint's order (the same result, bit for bit),
+  // but the innermost loop runs along a row and vectorises, with no bounds test per offset.
   for (int row = 0; row < rows; ++row) {
-    for (int column = 0; column < columns; ++column) {
-      double lowest = floor;
-      for (const Offset& o : footprint) {
-        const int c = column + o.dc, r = row + o.dr;
-        if (r >= 0 && r < rows && c >= 0 && c < columns) {
-          lowest = std::max(lowest, part_heights[static_cast<std::size_t>(r) * static_cast<std::size_t>(columns) +
-                                                 static_cast<std::size_t>(c)] -
-                                        o.lift);
-        }
+    double* const out = tip.data() + static_cast<std::ptrdiff_t>(row) * columns;
+    for (const Offset& o : footprint) {
+      const int r = row + o.dr;
+      if (r < 0 || r >= rows) {
+        continue;
       }
-      tip[static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column)] = lowest;
+      const double* const in = part_heights.data() + static_cast<std::ptrdiff_t>(r) * columns;
+      const double lift = o.lift;
+      for (int column = std::max(0, -o.dc), end = std::min(columns, columns - o.dc); column < end; ++column) {
+        out[column] = std::max(out[column], in[column + o.dc] - lift);
+      }
     }
   }
   return tip;
@@ -248,20 +252,24 @@ std::vector<double> MachinedPart::reachable_heights(const std::vector<double>& p
   }
   // The lowest the tool's surface can come over each cell from any of those tips.
   const std::vector<Offset> footprint = footprint_of(stock_, tool_);
-  const auto inside = [&](int c, int r) { return r >= 0 && r < rows && c >= 0 && c < columns; };
   std::vector<double> reachable(part.size(), top);
+  // As in lowest_tips: a row at a time, the footprint's offsets in order, along the row.
   for (int row = 0; row < rows; ++row) {
-    for (int column = 0; column < columns; ++column) {
-      const std::size_t i = static_cast<std::size_t>(row) * static_cast<std::size_t>(columns) + static_cast<std::size_t>(column);
-      double lowest = top;
-      for (const Offset& o : footprint) {
-        if (inside(column + o.dc, row + o.dr)) {
-          lowest = std::min(lowest, tip[static_cast<std::size_t>(row + o.dr) * static_cast<std::size_t>(columns) +
-                                        static_cast<std::size_t>(column + o.dc)] +
-                                        o.lift);
-        }
+    double* const out = reachable.data() + static_cast<std::ptrdiff_t>(row) * columns;
+    for (const Offset& o : footprint) {
+      const int r = row + o.dr;
+      if (r < 0 || r >= rows) {
+        continue;
       }
-      reachable[i] = std::max(lowest, part[i]);
+      const double* const in = tip.data() + static_cast<std::ptrdiff_t>(r) * columns;
+      const double lift = o.lift;
+      for (int column = std::max(0, -o.dc), end = std::min(columns, columns - o.dc); column < end; ++column) {
+        out[column] = std::min(out[column], in[column + o.dc] + lift);
+      }
+    }
+    const double* const floor_of = part.data() + static_cast<std::ptrdiff_t>(row) * columns;
+    for (int column = 0; column < columns; ++column) {
+      out[column] = std::max(out[column], floor_of[column]);
     }
   }
   return reachable;
