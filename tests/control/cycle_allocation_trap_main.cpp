@@ -35,6 +35,12 @@ int main() {
   config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
   config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
   config.home_tip_mm = Eigen::Vector3d(25.0, 12.5, 20.0);
+  // The wall's feel on (issue 29): the damper, the passivity controller and friction run in the
+  // trapped cycles too (today's rendering calls nothing they do not).
+  config.feel.damping_n_s_per_m = 3.0;
+  config.feel.passivity = true;
+  config.feel.friction = 0.5;
+  config.feel.transport_delay_s = 0.7e-3;
   auto controller = std::make_unique<control::Controller>(
       part, device, control::CycleRings{commands, machine_events, handoffs, telemetry, journal, taken, &display_commands}, config);
   if (!controller->ready()) {

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "firmware/core/motion/machine_planner.hpp"
+#include "firmware/core/stencil/surface_friction.hpp"
 
 namespace stencil::control {
 namespace {
@@ -47,6 +48,8 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
   board_axis_move_mm_ = config.max_axis_move_mm;
   board_total_move_mm_ = config.max_total_move_mm;
   waiting_for_hand_ = config.start_held;
+  stretch_rate_.configure(config.feel.velocity_cutoff_hz, config.period_s);
+  handle_velocity_.configure(config.feel.velocity_cutoff_hz, config.period_s);
 }
 
 ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
@@ -401,6 +404,7 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
                         engine::RemediationStatus::Stuck};
   outcome.desired_tip_mm = motion::device_to_world(config_.frames, outcome.device_mm);
   if (safe_reason_ != SafeReason::None || !usable || waiting_for_hand_) {
+    restart_wall_feel();
     return outcome;
   }
   // The mill's backlog: past half its path the virtual tool slows, to a stop at kBacklogHoldPercent,
@@ -417,9 +421,10 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
   // same spring that pulls it towards the tool when the tool lags.
   const engine::RemediationResult moved =
       paused_ ? engine::RemediationResult{engine::RemediationStatus::Stuck, tool_.tip_mm(), 0, 0, false}
-              : tool_.step(desired, outcome.contact, config_.contact);
+              : move_tool(desired, outcome.contact);
   outcome.remediation = moved.status;
-  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic);
+  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic,
+                                         wall_damping(outcome.device_mm, desired, outcome.contact));
   if (outcome.contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
       outcome.output.fault) {
     enter_safe_state(SafeReason::EngineFault);
@@ -428,6 +433,80 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
     max_offset_mm_ = std::max(max_offset_mm_, (desired - tool_.tip_mm()).norm());
   }
   return outcome;
+}
+
+engine::RemediationResult Controller::move_tool(const Eigen::Vector3d& desired, const engine::ContactResult& contact) {
+  if (!(config_.feel.friction > 0.0)) {
+    return tool_.step(desired, contact, config_.contact);  // today's: slip, never stick
+  }
+  const engine::FrictionGoal goal =
+      engine::friction_goal(tool_.tip_mm(), desired, contact,
+                            config_.haptic.coupling_n_per_device_mm * config_.haptic.device_mm_per_world_mm,
+                            config_.feel.friction);
+  if (!goal.in_contact || !tool_on_surface_) {
+    // Not pushed into the part, or the tool still on its way to the surface: as without friction.
+    const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
+    tool_on_surface_ = goal.in_contact && (moved.status == engine::RemediationStatus::Slipped ||
+                                           moved.status == engine::RemediationStatus::Blocked ||
+                                           moved.status == engine::RemediationStatus::Stuck);
+    return moved;
+  }
+  // Resting on the surface: held by the cone. One more query, at the goal (bounded as the first);
+  // the engine still decides what is legal.
+  return tool_.step(goal.goal_mm, tool_.contact_at(goal.goal_mm, config_.contact), config_.contact);
+}
+
+Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const Eigen::Vector3d& desired,
+                                         const engine::ContactResult& contact) {
+  const engine::WallFeel& feel = config_.feel;
+  if (!(feel.damping_n_s_per_m > 0.0) && !feel.passivity) {
+    return Eigen::Vector3d::Zero();
+  }
+  const Eigen::Vector3d stretch_m = 1e-3 * config_.haptic.device_mm_per_world_mm * (tool_.tip_mm() - desired);
+  const Eigen::Vector3d handle_m = 1e-3 * device_mm;
+  const Eigen::Vector3d last_force(last_command_.force_n[0], last_command_.force_n[1], last_command_.force_n[2]);
+  const bool penetrating = contact.penetrating_points > 0;
+  // The estimates move with the device's samples: a stale period repeats the last ones.
+  if (fresh_) {
+    static_cast<void>(stretch_rate_.update(stretch_m));
+    static_cast<void>(handle_velocity_.update(handle_m));
+    if (feel.passivity) {
+      if (penetrating && !was_penetrating_) {
+        passivity_.restart();  // a contact starts: its balance is its own
+      } else if (have_last_handle_) {
+        // What the device held over the period just ended: the last command, after the link's delay;
+        // before it, the one before.
+        const double late = std::clamp(feel.transport_delay_s / config_.period_s, 0.0, 1.0);
+        static_cast<void>(passivity_.observe((1.0 - late) * last_force + late * force_before_, handle_m - last_handle_m_));
+      }
+      // Relaxed (no stretch, nothing penetrating) and owing nothing: the wall holds nothing.
+      if (!penetrating && stretch_m.norm() < 1e-6 && passivity_.energy_j() <= 0.0) {
+        passivity_.restart();
+      }
+    }
+    last_handle_m_ = handle_m;
+    have_last_handle_ = true;
+  }
+  force_before_ = last_force;
+  was_penetrating_ = penetrating;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  if (feel.damping_n_s_per_m > 0.0) {
+    force += feel.damping_n_s_per_m * stretch_rate_.value();
+  }
+  if (feel.passivity) {
+    force += passivity_.correction(handle_velocity_.value(), config_.period_s, config_.haptic.max_force_n);
+  }
+  return force;
+}
+
+void Controller::restart_wall_feel() {
+  stretch_rate_.reset();
+  handle_velocity_.reset();
+  passivity_.restart();
+  have_last_handle_ = false;
+  was_penetrating_ = false;
+  force_before_.setZero();
+  tool_on_surface_ = false;
 }
 
 void Controller::write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output) {

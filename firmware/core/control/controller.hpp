@@ -15,7 +15,9 @@
 #include "firmware/core/motion/machine_frames.hpp"
 #include "firmware/core/stencil/contact_query.hpp"
 #include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/stencil/passivity_controller.hpp"
 #include "firmware/core/stencil/triangle_set.hpp"
+#include "firmware/core/stencil/velocity_filter.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/part_tables.hpp"
 #include "hal/haptic_device.hpp"
@@ -27,6 +29,7 @@ struct ControllerConfig {
   motion::MachineFrames frames;           // device -> world
   engine::ContactParameters contact;
   engine::HapticLimits haptic;
+  engine::WallFeel feel;                  // damping, passivity, friction: all off by default
   Eigen::Vector3d device_low_mm;          // a sample outside [low, high] (device mm) is out of the reach
   Eigen::Vector3d device_high_mm;
   Eigen::Vector3d home_tip_mm;            // world: where the virtual tool starts (the machine's home)
@@ -160,6 +163,14 @@ class Controller {
   void write_force(hal::MonotonicNs now_ns, bool usable, const engine::HapticOutput& output);
   // The journal record, the machine handoff and the telemetry, in that order.
   void publish(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns, const EngineOutcome& outcome);
+  // Where the virtual tool goes this cycle and how: towards the hand, or as the friction cone lets it.
+  [[nodiscard]] engine::RemediationResult move_tool(const Eigen::Vector3d& desired, const engine::ContactResult& contact);
+  // The wall's damping this cycle (N): the coupling's virtual damper and the passivity controller's
+  // correction; zero with both off (today's rendering: nothing is computed).
+  [[nodiscard]] Eigen::Vector3d wall_damping(const Eigen::Vector3d& device_mm, const Eigen::Vector3d& desired,
+                                             const engine::ContactResult& contact);
+  // The estimates start again (after any cycle that rendered no force): no stale velocity, no old balance.
+  void restart_wall_feel();
   [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
   [[nodiscard]] Telemetry build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
                                           const EngineOutcome& outcome) const;
@@ -208,6 +219,16 @@ class Controller {
   hal::HapticCommand last_command_{};
   double max_force_n_ = 0.0;
   double max_offset_mm_ = 0.0;
+  // The wall's feel (config_.feel): the rate the coupling stretches, the handle's velocity (both
+  // device metres per second), the energy balance, and the handle's last position.
+  engine::VelocityFilter stretch_rate_;
+  engine::VelocityFilter handle_velocity_;
+  engine::PassivityController passivity_;
+  Eigen::Vector3d last_handle_m_ = Eigen::Vector3d::Zero();
+  bool have_last_handle_ = false;
+  Eigen::Vector3d force_before_ = Eigen::Vector3d::Zero();  // the command before last_command_ (N)
+  bool was_penetrating_ = false;                            // last cycle's desired pose was in contact
+  bool tool_on_surface_ = false;  // friction: the tool rests on the part (it slid onto it, or was held)
   LoopStatistics statistics_;
   CycleCounters counters_;
 };

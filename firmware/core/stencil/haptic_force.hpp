@@ -15,6 +15,25 @@ struct HapticLimits {
   double max_torque_nmm = 200.0;
 };
 
+// How the wall feels beyond the coupling's spring (issue 29). All off by default: today's rendering,
+// a spring to the virtual tool that slips along the part without sticking.
+struct WallFeel {
+  // Virtual damping on the coupling (N s per device metre): resists the rate at which the coupling
+  // stretches or relaxes, so it acts in contact and wherever the tool lags the hand (the speed
+  // limit), not while the tool follows the hand freely.
+  double damping_n_s_per_m = 0.0;
+  // The passivity observer and controller (passivity_controller.hpp): damping only where the wall
+  // has put out more energy than it took.
+  bool passivity = false;
+  // Coulomb friction of the virtual tool on the part (surface_friction.hpp), 0 to 1.
+  double friction = 0.0;
+  // The corner of the velocity estimate's low-pass (velocity_filter.hpp), Hz.
+  double velocity_cutoff_hz = 100.0;
+  // The device link's delay from command to motor (s): the passivity observer weighs the two last
+  // commands by it for the force the device really held over the period.
+  double transport_delay_s = 0.0;
+};
+
 struct HapticOutput {
   Eigen::Vector3d force_n;
   Eigen::Vector3d torque_nmm;
@@ -23,9 +42,11 @@ struct HapticOutput {
 };
 
 // force = coupling * (virtual - desired) in device millimetres + the contact force at the desired
-// pose, clamped in magnitude to max_force_n; torque likewise to max_torque_nmm. A NaN or infinity
-// anywhere gives zero force and torque and the fault flag. Real-time safe.
+// pose + `added_force_n` (the wall's damping, when the cycle renders it), clamped in magnitude to
+// max_force_n; torque likewise to max_torque_nmm. A NaN or infinity anywhere gives zero force and
+// torque and the fault flag. Real-time safe.
 [[nodiscard]] HapticOutput haptic_output(const Eigen::Vector3d& desired_tip_mm, const Eigen::Vector3d& virtual_tip_mm,
-                                         const ContactResult& contact_at_desired, const HapticLimits& limits);
+                                         const ContactResult& contact_at_desired, const HapticLimits& limits,
+                                         const Eigen::Vector3d& added_force_n = Eigen::Vector3d::Zero());
 
 }  // namespace stencil::engine

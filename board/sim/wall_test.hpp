@@ -1,0 +1,84 @@
+// The wall's feel, measured (issue 29): a simulated hand and device (sim/operator/hand_device_model)
+// tap and slide on the part's top face through the real cycle (control::Controller) over a direct
+// device link, and what the hand felt is summed up per case: the first rebound, the oscillation left
+// 100 ms after contact, the energy the wall put into the hand, and sliding, the friction it felt.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/tables/part_tables.hpp"
+#include "sim/operator/hand_device_model.hpp"
+
+namespace stencil::board::sim {
+
+enum class WallRendering : std::uint8_t {
+  Previous,  // today's: the coupling's spring and the contact force, nothing else
+  New,       // with the virtual damper and the passivity controller (new_wall_feel)
+};
+enum class WallTestKind : std::uint8_t { Tap, Slide };
+
+[[nodiscard]] const char* name_of(WallRendering rendering);
+[[nodiscard]] const char* name_of(WallTestKind test);
+
+// The couplings the display allows, low to high (N per device mm; control::ControllerConfig's range).
+inline constexpr double kWallCouplings[] = {0.05, 0.1, 0.2, 0.5, 1.0, 2.0};
+
+// Each transport's delay from the cycle's command to the device's motors (s), for --transport.
+// direct: in process, none. pio: the device's own 1 kHz loop reads the window at a phase of its own,
+// on average half a period later. can: the two command frames (0x100, 0x101: 8 data bytes, about
+// 130 bits each with stuffing) take 0.26 ms at 1 Mbit/s, after the device's three pose frames of the
+// same period (0.4 ms): 0.7 ms (hal/socketcan/can_bus_load.hpp counts the bits).
+inline constexpr double kDirectDelayS = 0.0;
+inline constexpr double kPioDelayS = 0.5e-3;
+inline constexpr double kCanDelayS = 0.7e-3;
+
+struct WallCase {
+  stencil::sim::HandParameters hand = stencil::sim::kMediumHand;
+  double coupling_n_per_device_mm = 0.5;
+  WallRendering rendering = WallRendering::Previous;
+  WallTestKind test = WallTestKind::Tap;
+  double speed_device_mm_per_s = 1000.0;  // tap: the hand's speed into the face; slide: along it
+  double push_n = 2.0;                    // what the hand pushes into the face with once there
+  double friction = 0.0;                  // the coefficient set (both renderings take it)
+  double transport_delay_s = kDirectDelayS;
+};
+
+struct WallRow {
+  WallCase c;
+  // Tap, and a slide's press onto the face (a tap at 100 device mm/s): the handle's depth past the
+  // face's plane (device mm, + into the part).
+  double first_peak_mm = 0.0;     // where the handle first turned back (or the deepest in the first 100 ms)
+  double rebound_mm = 0.0;        // the farthest it came back out past the face after first touching it
+  // What oscillates from 100 ms after contact (or after the hand stopped pushing in, if later): the
+  // largest departure from the least-squares line through the depth over the next 200 ms (a slow
+  // settling is not an oscillation), over the first peak.
+  double residual_fraction = 0.0;
+  double wall_energy_j = 0.0;     // the work the rendered force did on the handle (+: into the hand):
+                                  // tap, in and out again; slide, the press and hold
+  bool stable = false;            // residual_fraction at most 5 %
+  bool passive = false;           // wall_energy_j at most 1e-6 J
+  double friction_ratio = 0.0;    // slide: tangential over normal force over the periods the tool slid
+  double stuck_slip_mm = 0.0;     // slide: how far the tool moved along the face while held inside the cone (world mm)
+  std::string error;              // not empty: the case could not run (the cycle went to a safe state ...)
+};
+
+// The new rendering at a coupling: virtual damping of 10 + 20 N s/m per N per device mm of the
+// wall's stiffness (the coupling plus the contact's), from a sweep over the three hands (a hand
+// ringing on the wall dies down to 5 % within 100 ms only with about 60 N s/m per kg of moving mass,
+// the more the stiffer the wall; more at a soft wall and the hand creeps in), and the passivity
+// controller for whatever energy the sampled wall still puts out. `period_s` is the cycle's.
+[[nodiscard]] engine::WallFeel new_wall_feel(double coupling_n_per_device_mm, double contact_stiffness_n_per_device_mm,
+                                             double period_s, double friction);
+
+// One case on `part` (its top face, from above the middle of it). Deterministic: virtual time.
+[[nodiscard]] WallRow run_wall_case(const tables::PartTables& part, const WallCase& c);
+
+// A row as one line of JSON (issue 29's fields), and as a line of the table.
+[[nodiscard]] std::string wall_row_json(const WallRow& row);
+[[nodiscard]] std::string wall_row_text(const WallRow& row);
+[[nodiscard]] std::string wall_table_header();
+
+}  // namespace stencil::board::sim

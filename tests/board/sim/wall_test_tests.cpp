@@ -1,0 +1,86 @@
+// The wall's feel, measured (board/sim/wall_test.hpp): taps and slides through the real cycle with a
+// simulated hand, on the hex prism's top face.
+#include <cmath>
+#include <string>
+
+#include "board/sim/wall_test.hpp"
+#include "firmware/core/tables/table_loader.hpp"
+#include "tests/support/sample_tables.hpp"
+
+// CppUTest last: its leak-detector macros redefine new for what follows.
+#include <CppUTest/TestHarness.h>
+
+using namespace stencil;
+using namespace stencil::board::sim;
+
+namespace {
+
+struct Prism {
+  tablegen::TableBytes bytes = test::make_table(test::default_part(), test::default_job_options(2));
+  tables::PartTables part{};
+  Prism() { CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok); }
+};
+
+WallCase tap(const stencil::sim::HandParameters& hand, double coupling, WallRendering rendering) {
+  WallCase c;
+  c.hand = hand;
+  c.coupling_n_per_device_mm = coupling;
+  c.rendering = rendering;
+  c.test = WallTestKind::Tap;
+  c.speed_device_mm_per_s = 1000.0;
+  c.transport_delay_s = kCanDelayS;
+  return c;
+}
+
+WallCase slide(double friction, WallRendering rendering) {
+  WallCase c;
+  c.hand = stencil::sim::kMediumHand;
+  c.coupling_n_per_device_mm = 0.5;
+  c.rendering = rendering;
+  c.test = WallTestKind::Slide;
+  c.speed_device_mm_per_s = 50.0;
+  c.friction = friction;
+  return c;
+}
+
+}  // namespace
+
+TEST_GROUP(WallTest){};
+
+TEST(WallTest, ATapReachesTheFaceAndIsHeldAgainstItWithTheHandsPush) {
+  const Prism prism;
+  const WallRow row = run_wall_case(prism.part, tap(stencil::sim::kMediumHand, 0.5, WallRendering::Previous));
+  STRCMP_EQUAL("", row.error.c_str());
+  CHECK(row.first_peak_mm > 0.0);
+  CHECK(std::isfinite(row.wall_energy_j));
+  CHECK(std::isfinite(row.residual_fraction));
+}
+
+TEST(WallTest, SlidingWithFrictionTheHandFeelsMuTimesThePushAndInsideTheConeTheToolSticks) {
+  const Prism prism;
+  const WallRow row = run_wall_case(prism.part, slide(0.5, WallRendering::New));
+  STRCMP_EQUAL("", row.error.c_str());
+  DOUBLES_EQUAL(0.5, row.friction_ratio, 0.025);  // issue 29: within 5 % of the coefficient
+  CHECK(row.stuck_slip_mm < 1e-6);
+}
+
+TEST(WallTest, WithoutFrictionTheToolSlipsAndTheHandFeelsNoPullAlongTheFace) {
+  const Prism prism;
+  const WallRow row = run_wall_case(prism.part, slide(0.0, WallRendering::Previous));
+  STRCMP_EQUAL("", row.error.c_str());
+  CHECK(row.friction_ratio < 0.02);
+}
+
+TEST(WallTest, ARowIsOneLineOfJsonWithTheIssuesFields) {
+  WallRow row;
+  row.c = tap(stencil::sim::kRelaxedHand, 2.0, WallRendering::New);
+  row.rebound_mm = 0.25;
+  const std::string json = wall_row_json(row);
+  for (const char* field : {"\"hand\":\"relaxed\"", "\"coupling_n_per_device_mm\":2.0", "\"rendering\":\"new\"",
+                            "\"test\":\"tap\"", "\"rebound_mm\":0.25", "\"residual_fraction\"", "\"wall_energy_j\"",
+                            "\"stable\"", "\"passive\""}) {
+    CHECK_TEXT(json.find(field) != std::string::npos, field);
+  }
+  CHECK(json.find('\n') == std::string::npos);
+  CHECK(json.find("friction_ratio") == std::string::npos);  // a tap has none
+}
