@@ -57,6 +57,7 @@ struct Sample {
   double t_s;
   Eigen::Vector3d handle_mm;  // device
   Eigen::Vector3d force_n;    // commanded, device
+  Eigen::Vector3d applied_n;  // what the device's motors drove over the period (after the link's delay)
   Eigen::Vector3d tip_mm;     // the virtual tool, world
 };
 
@@ -77,6 +78,7 @@ class WallBench {
   [[nodiscard]] double now_s() const { return static_cast<double>(now_ns_ - kStartNs) * 1e-9; }
   [[nodiscard]] const std::vector<Sample>& samples() const { return samples_; }
   [[nodiscard]] control::SafeReason safe_reason() const { return controller_->safe_reason(); }
+  [[nodiscard]] const motion::MachineFrames& frames() const { return config_.frames; }
 
   // One period: the hand and device move to now, the device's sample goes to the cycle, the cycle's
   // command goes to the device. False once the cycle is in a safe state.
@@ -96,8 +98,9 @@ class WallBench {
     drain();
     const hal::HapticCommand& command = device_.rendered();
     const Eigen::Vector3d force(command.force_n[0], command.force_n[1], command.force_n[2]);
+    const Eigen::Vector3d applied = model_.applied_force_n();
     static_cast<void>(model_.command_force(now_ns_, force));
-    samples_.push_back({now_s(), handle, force, controller_->virtual_tip_mm()});
+    samples_.push_back({now_s(), handle, force, applied, controller_->virtual_tip_mm()});
     return status == control::CycleStatus::Running;
   }
 
@@ -247,20 +250,20 @@ void run_tap(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start, 
   contact_figures(bench.samples(), from, held_until, wall_z, intent_stops_s, row);
 }
 
-// The hand pulls along the face (+x) by ramping its intent until the tangential force the cycle
-// renders reaches `pull_n`, then holds; false on a safe state or when it never gets there in 2 s.
+// The hand pulls along the face (+x) by ramping its intent until the pull the cycle renders against
+// it (-x, beyond what it rendered when the ramp began) reaches `pull_n`, then holds; false on a safe
+// state or when it never gets there in 2 s.
 bool ramp_pull(WallBench& bench, const Eigen::Vector3d& from, double pull_n) {
+  const double start_x = bench.samples().back().force_n.x();
   Eigen::Vector3d intent = from;
   for (int i = 0; i < 2000; ++i) {
-    const Eigen::Vector3d& f = bench.samples().back().force_n;
-    if (std::hypot(f.x(), f.y()) >= pull_n) {
-      bench.model().set_intent(intent, Eigen::Vector3d::Zero());
-      return true;
-    }
     intent.x() += 0.01;  // 10 device mm/s
     bench.model().set_intent(intent, Eigen::Vector3d::Zero());
     if (!bench.step()) {
       return false;
+    }
+    if (start_x - bench.samples().back().force_n.x() >= pull_n) {
+      return true;
     }
   }
   return false;
@@ -305,14 +308,15 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
     row.error = safe_state_error(bench, "while sliding");
     return;
   }
+  // The force the hand felt: what the motors drove (after the link's delay), not the command.
   double tangential = 0.0, normal = 0.0;
   int slipping = 0;
   const std::vector<Sample>& s = bench.samples();
   for (std::size_t i = measured_from; i < s.size(); ++i) {
     const Eigen::Vector3d moved = s[i].tip_mm - s[i - 1].tip_mm;
     if (std::hypot(moved.x(), moved.y()) > 1e-7) {
-      tangential += std::hypot(s[i].force_n.x(), s[i].force_n.y());
-      normal += s[i].force_n.z();
+      tangential += std::hypot(s[i].applied_n.x(), s[i].applied_n.y());
+      normal += s[i].applied_n.z();
       ++slipping;
     }
   }
@@ -321,9 +325,11 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
     return;
   }
   row.friction_ratio = tangential / normal;
-  // Held inside the cone: the hand stops where the handle is (no pull left), then pulls along the
-  // face, slowly, until the rendered pull is half what the cone holds; the tool must not move.
-  bench.model().set_intent(Eigen::Vector3d(bench.model().position_mm().x(), pressed.y(), pressed.z()), Eigen::Vector3d::Zero());
+  // Held inside the cone: the hand stops right over the tool (no pull left along the face), then
+  // pulls along it, slowly, until the pull is half what the cone holds; the tool must not move.
+  const double over_tool_x = motion::world_to_device(bench.frames(), bench.samples().back().tip_mm).x();
+  const Eigen::Vector3d resting(over_tool_x, pressed.y(), pressed.z());
+  bench.model().set_intent(resting, Eigen::Vector3d::Zero());
   if (!bench.run_for(0.4)) {
     row.error = safe_state_error(bench, "while resting on the face");
     return;
@@ -331,8 +337,7 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
   const double normal_n = std::max(bench.samples().back().force_n.z(), 0.0);
   const Eigen::Vector3d tip_before = bench.samples().back().tip_mm;
   if (c.friction > 0.0) {
-    if (!ramp_pull(bench, Eigen::Vector3d(bench.model().position_mm().x(), pressed.y(), pressed.z()),
-                   0.5 * c.friction * normal_n) ||
+    if (!ramp_pull(bench, resting, 0.5 * c.friction * normal_n) ||
         !bench.run_for(0.3)) {
       row.error = "held inside the cone: the pull never reached half of it, or the cycle stopped";
       return;

@@ -39,10 +39,11 @@ TEST(PassivityController, APositiveBalanceIsTakenBackOverTheNextPeriodAgainstThe
   DOUBLES_EQUAL(-1e-5, force.dot(velocity * 1e-3), 1e-15);
 }
 
-TEST(PassivityController, TheCorrectionIsBoundedByTheForceLimitAndNoneForAStillHandle) {
+TEST(PassivityController, TheCorrectionIsBoundedByItsDampingAndTheForceLimitAndNoneForAStillHandle) {
   PassivityController pc;
-  static_cast<void>(pc.observe({5.0, 0.0, 0.0}, {1e-3, 0.0, 0.0}));  // 5 mJ
-  DOUBLES_EQUAL(5.0, pc.correction({0.01, 0.0, 0.0}, 1e-3, 5.0).norm(), 1e-12);
+  static_cast<void>(pc.observe({5.0, 0.0, 0.0}, {1e-3, 0.0, 0.0}));  // 5 mJ: 50,000 N s/m at 0.01 m/s
+  DOUBLES_EQUAL(PassivityController::kMaxDampingNSPerM * 0.01, pc.correction({0.01, 0.0, 0.0}, 1e-3, 5.0).norm(), 1e-12);
+  DOUBLES_EQUAL(5.0, pc.correction({0.1, 0.0, 0.0}, 1e-3, 5.0).norm(), 1e-12);  // 10 N, limited to 5
   CHECK(pc.correction({PassivityController::kStillSpeedMPerS / 2.0, 0.0, 0.0}, 1e-3, 5.0).isZero());
 }
 

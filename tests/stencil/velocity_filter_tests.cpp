@@ -59,3 +59,12 @@ TEST(VelocityFilter, AfterAResetTheNextSampleStartsAgainFromZero) {
   CHECK(filter.value().isZero());
   CHECK(filter.update(Eigen::Vector3d(50.0, 0.0, 0.0)).isZero());  // no jump from the gap
 }
+
+TEST(VelocityFilter, ASampleAfterAGapIsDifferencedOverTheTimeSinceTheLastOne) {
+  // A steady 10 per second, with the third sample two periods after the second (a stale read).
+  VelocityFilter filter;
+  filter.configure(1000.0, 1e-3);  // at Nyquist: the raw difference passes
+  static_cast<void>(filter.update(Eigen::Vector3d::Zero()));
+  DOUBLES_EQUAL(10.0, filter.update(Eigen::Vector3d(0.01, 0.0, 0.0)).x(), 1e-9);
+  DOUBLES_EQUAL(10.0, filter.update(Eigen::Vector3d(0.03, 0.0, 0.0), 2e-3).x(), 1e-9);
+}

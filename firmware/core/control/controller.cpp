@@ -16,6 +16,9 @@ constexpr double kNsPerS = 1e9;
 // handoff ring more (4096 x 13 % > 512), all a machine update can take in before it reports again,
 // so the path never fills while the cycle runs (a full path would leave a gap in it).
 constexpr double kBacklogHoldPercent = 87.0;
+// Friction holds a tool that rests on the part: the part within this much below it along the normal
+// (world mm; twice the contact tolerance).
+constexpr double kRestingProbeMm = 0.01;
 static_assert((100.0 - kBacklogHoldPercent) / 100.0 * motion::MachinePlanner::kPathCapacity >
               MachineHandoffRing::capacity());
 
@@ -443,17 +446,28 @@ engine::RemediationResult Controller::move_tool(const Eigen::Vector3d& desired, 
       engine::friction_goal(tool_.tip_mm(), desired, contact,
                             config_.haptic.coupling_n_per_device_mm * config_.haptic.device_mm_per_world_mm,
                             config_.feel.friction);
-  if (!goal.in_contact || !tool_on_surface_) {
-    // Not pushed into the part, or the tool still on its way to the surface: as without friction.
-    const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
-    tool_on_surface_ = goal.in_contact && (moved.status == engine::RemediationStatus::Slipped ||
-                                           moved.status == engine::RemediationStatus::Blocked ||
-                                           moved.status == engine::RemediationStatus::Stuck);
-    return moved;
+  if (goal.in_contact && tool_on_surface_) {
+    // Held only while the tool really rests on the part: the part just below it along the normal (a
+    // tool that slid off an edge, or lagged above the face, is not held in the air).
+    const Eigen::Vector3d normal = contact.force_n.normalized();
+    const engine::ContactResult below =
+        tool_.contact_at(tool_.tip_mm() - kRestingProbeMm * normal, config_.contact);
+    if (below.status == engine::QueryStatus::Ok && below.penetrating_points > 0) {
+      if (goal.sticking) {
+        return {engine::RemediationStatus::Stuck, tool_.tip_mm(), 0, 0, false};  // held where it is
+      }
+      // One more query, at the goal (bounded as the others); the engine still decides what is legal.
+      return tool_.step(goal.goal_mm, tool_.contact_at(goal.goal_mm, config_.contact), config_.contact);
+    }
   }
-  // Resting on the surface: held by the cone. One more query, at the goal (bounded as the first);
-  // the engine still decides what is legal.
-  return tool_.step(goal.goal_mm, tool_.contact_at(goal.goal_mm, config_.contact), config_.contact);
+  // Not pushed into the part, or the tool not (yet) resting on it: as without friction. It rests once
+  // the part stopped it short of the hand, not the speed limit.
+  const engine::RemediationResult moved = tool_.step(desired, contact, config_.contact);
+  tool_on_surface_ = goal.in_contact && !moved.speed_limited &&
+                     (moved.status == engine::RemediationStatus::Slipped ||
+                      moved.status == engine::RemediationStatus::Blocked ||
+                      moved.status == engine::RemediationStatus::Stuck);
+  return moved;
 }
 
 Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const Eigen::Vector3d& desired,
@@ -466,16 +480,18 @@ Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const
   const Eigen::Vector3d handle_m = 1e-3 * device_mm;
   const Eigen::Vector3d last_force(last_command_.force_n[0], last_command_.force_n[1], last_command_.force_n[2]);
   const bool penetrating = contact.penetrating_points > 0;
-  // The estimates move with the device's samples: a stale period repeats the last ones.
+  // The estimates move with the device's samples (a stale period repeats the last ones), each over
+  // the time since the last fresh sample.
   if (fresh_) {
-    static_cast<void>(stretch_rate_.update(stretch_m));
-    static_cast<void>(handle_velocity_.update(handle_m));
+    const double elapsed_s = have_last_handle_ ? static_cast<double>(sample_time_ns_ - last_handle_ns_) / kNsPerS : 0.0;
+    static_cast<void>(stretch_rate_.update(stretch_m, elapsed_s));
+    static_cast<void>(handle_velocity_.update(handle_m, elapsed_s));
     if (feel.passivity) {
       if (penetrating && !was_penetrating_) {
-        passivity_.restart();  // a contact starts: its balance is its own
+        passivity_.forget_absorbed();  // a contact starts: its balance is its own, less any debt
       } else if (have_last_handle_) {
-        // What the device held over the period just ended: the last command, after the link's delay;
-        // before it, the one before.
+        // What the device held since the last fresh sample: the last command, after the link's
+        // delay, and before it the one before (a delay over a period counts as one period).
         const double late = std::clamp(feel.transport_delay_s / config_.period_s, 0.0, 1.0);
         static_cast<void>(passivity_.observe((1.0 - late) * last_force + late * force_before_, handle_m - last_handle_m_));
       }
@@ -485,13 +501,28 @@ Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const
       }
     }
     last_handle_m_ = handle_m;
+    last_handle_ns_ = sample_time_ns_;
     have_last_handle_ = true;
   }
   force_before_ = last_force;
   was_penetrating_ = penetrating;
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
-  if (feel.damping_n_s_per_m > 0.0) {
-    force += feel.damping_n_s_per_m * stretch_rate_.value();
+  if (!penetrating && stretch_m.norm() < 1e-6) {
+    return force;  // nothing in contact, the tool with the hand: no wall to damp
+  }
+  if (feel.damping_n_s_per_m > 0.0 && penetrating && contact.force_n.allFinite()) {
+    // The damper resists the hand going into the part and moving along it, never pulls it in: its
+    // part along the surface's normal is dropped when it points into the part (a hand leaving the
+    // wall is not held back).
+    force = feel.damping_n_s_per_m * stretch_rate_.value();
+    const double normal_n = contact.force_n.norm();
+    if (normal_n > 0.0) {
+      const Eigen::Vector3d normal = contact.force_n / normal_n;
+      const double inward = force.dot(normal);
+      if (inward < 0.0) {
+        force -= inward * normal;
+      }
+    }
   }
   if (feel.passivity) {
     force += passivity_.correction(handle_velocity_.value(), config_.period_s, config_.haptic.max_force_n);

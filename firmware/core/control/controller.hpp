@@ -225,6 +225,7 @@ class Controller {
   engine::VelocityFilter handle_velocity_;
   engine::PassivityController passivity_;
   Eigen::Vector3d last_handle_m_ = Eigen::Vector3d::Zero();
+  hal::MonotonicNs last_handle_ns_ = 0;  // when that sample was read
   bool have_last_handle_ = false;
   Eigen::Vector3d force_before_ = Eigen::Vector3d::Zero();  // the command before last_command_ (N)
   bool was_penetrating_ = false;                            // last cycle's desired pose was in contact

@@ -20,7 +20,7 @@ Eigen::Vector3d PassivityController::correction(const Eigen::Vector3d& velocity_
       speed_squared < kStillSpeedMPerS * kStillSpeedMPerS) {
     return Eigen::Vector3d::Zero();
   }
-  const double alpha_n_s_per_m = energy_j_ / (period_s * speed_squared);
+  const double alpha_n_s_per_m = std::fmin(energy_j_ / (period_s * speed_squared), kMaxDampingNSPerM);
   Eigen::Vector3d force = -alpha_n_s_per_m * velocity_m_per_s;
   const double magnitude = force.norm();
   if (magnitude > max_force_n) {

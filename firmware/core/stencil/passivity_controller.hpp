@@ -20,6 +20,9 @@ class PassivityController {
   // Below this speed (m/s) no damping is added: the damping that would take the balance back in a
   // period grows as 1 / v^2, and one encoder count (1 um) a period is already 1e-3 m/s of noise.
   static constexpr double kStillSpeedMPerS = 2e-3;
+  // The most damping it adds (N s/m): a few microjoules owed would otherwise be a kick at the force
+  // limit the moment the handle moves; what is left is taken back over more periods.
+  static constexpr double kMaxDampingNSPerM = 100.0;
 
   // One period: the force the device held over the period that just ended (N) and how far the
   // handle moved over it (m). Returns the balance (J): positive, the wall has put energy in.
@@ -36,6 +39,8 @@ class PassivityController {
   // so that one contact's excess is never paid for by what another (or dragging the lagging tool)
   // absorbed.
   void restart() { energy_j_ = 0.0; }
+  // A contact starts: what the wall absorbed before it is forgotten, what it still owes is not.
+  void forget_absorbed() { energy_j_ = energy_j_ > 0.0 ? energy_j_ : 0.0; }
 
   [[nodiscard]] double energy_j() const { return energy_j_; }
 

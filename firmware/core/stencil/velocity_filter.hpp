@@ -27,10 +27,12 @@ class VelocityFilter {
   }
 
   // One sample: the estimate in position units per second. The first sample after a reset gives
-  // zero (there is nothing to difference yet).
-  const Eigen::Vector3d& update(const Eigen::Vector3d& position) {
-    if (have_last_ && period_s_ > 0.0) {
-      const Eigen::Vector3d raw = (position - last_) / period_s_;
+  // zero (there is nothing to difference yet). `elapsed_s` is the time since the last sample when
+  // it was not one period (a stale read in between); the filter's own step stays one period.
+  const Eigen::Vector3d& update(const Eigen::Vector3d& position, double elapsed_s = 0.0) {
+    const double dt = elapsed_s > 0.0 ? elapsed_s : period_s_;
+    if (have_last_ && dt > 0.0) {
+      const Eigen::Vector3d raw = (position - last_) / dt;
       value_ += alpha_ * (raw - value_);
     }
     last_ = position;
