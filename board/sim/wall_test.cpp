@@ -19,7 +19,6 @@
 namespace stencil::board::sim {
 namespace {
 
-constexpr hal::MonotonicNs kPeriodNs = 1'000'000;
 constexpr double kStableFraction = 0.05;   // issue 29: at most 5 % of the first peak left after 100 ms
 constexpr double kPassiveEnergyJ = 1e-6;   // issue 29: at most 1 uJ put in per contact
 // The new rendering's virtual damping, N s per device metre: 10 plus 20 per N/mm of the wall's
@@ -353,10 +352,9 @@ const char* name_of(WallRendering rendering) { return rendering == WallRendering
 const char* name_of(WallTestKind test) { return test == WallTestKind::Slide ? "slide" : "tap"; }
 
 engine::WallFeel new_wall_feel(double coupling_n_per_device_mm, double contact_stiffness_n_per_device_mm,
-                               double period_s, double friction) {
+                               double friction) {
   engine::WallFeel feel;
   const double stiffness_n_per_m = 1e3 * (coupling_n_per_device_mm + contact_stiffness_n_per_device_mm);
-  static_cast<void>(period_s);
   feel.damping_n_s_per_m = kDampingBaseNSPerM + kDampingPerStiffnessNSPerM * 1e-3 * stiffness_n_per_m;
   feel.passivity = true;
   feel.friction = friction;
@@ -374,7 +372,7 @@ WallRow run_wall_case(const tables::PartTables& part, const WallCase& c) {
   config.max_total_move_mm = std::numeric_limits<double>::infinity();
   config.haptic.coupling_n_per_device_mm = c.coupling_n_per_device_mm;
   config.feel = c.rendering == WallRendering::New
-                    ? new_wall_feel(c.coupling_n_per_device_mm, config.contact.stiffness_n_per_device_mm, config.period_s,
+                    ? new_wall_feel(c.coupling_n_per_device_mm, config.contact.stiffness_n_per_device_mm,
                                     c.friction)
                     : engine::WallFeel{};
   config.feel.friction = c.friction;  // the case's: 0 for today's rendering, which has none

@@ -69,9 +69,9 @@ struct WallRow {
 // wall's stiffness (the coupling plus the contact's), from a sweep over the three hands (a hand
 // ringing on the wall dies down to 5 % within 100 ms only with about 60 N s/m per kg of moving mass,
 // the more the stiffer the wall; more at a soft wall and the hand creeps in), and the passivity
-// controller for whatever energy the sampled wall still puts out. `period_s` is the cycle's.
+// controller for whatever energy the sampled wall still puts out.
 [[nodiscard]] engine::WallFeel new_wall_feel(double coupling_n_per_device_mm, double contact_stiffness_n_per_device_mm,
-                                             double period_s, double friction);
+                                             double friction);
 
 // One case on `part` (its top face, from above the middle of it). Deterministic: virtual time.
 [[nodiscard]] WallRow run_wall_case(const tables::PartTables& part, const WallCase& c);
