@@ -511,16 +511,21 @@ Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const
     return force;  // nothing in contact, the tool with the hand: no wall to damp
   }
   if (feel.damping_n_s_per_m > 0.0 && penetrating && contact.force_n.allFinite()) {
-    // The damper resists the hand going into the part and moving along it, never pulls it in: its
-    // part along the surface's normal is dropped when it points into the part (a hand leaving the
-    // wall is not held back).
+    // The damper acts both ways while the hand is in the wall (it takes the energy out of the
+    // rebound as well as the approach), but a wall only pushes: the damper may take the wall's push
+    // along the normal down to zero, never past it into a pull towards the part (Colgate's
+    // unilateral virtual wall).
     force = feel.damping_n_s_per_m * stretch_rate_.value();
     const double normal_n = contact.force_n.norm();
     if (normal_n > 0.0) {
       const Eigen::Vector3d normal = contact.force_n / normal_n;
+      const Eigen::Vector3d wall_n = config_.haptic.coupling_n_per_device_mm * config_.haptic.device_mm_per_world_mm *
+                                         (tool_.tip_mm() - desired) +
+                                     contact.force_n;
+      const double push_n = std::fmax(wall_n.dot(normal), 0.0);
       const double inward = force.dot(normal);
-      if (inward < 0.0) {
-        force -= inward * normal;
+      if (inward < -push_n) {
+        force -= (inward + push_n) * normal;
       }
     }
   }
