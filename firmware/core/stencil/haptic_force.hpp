@@ -2,6 +2,8 @@
 // clamped to the rig's safe limits, and never anything but finite numbers.
 #pragma once
 
+#include <cstdint>
+
 #include <Eigen/Core>
 
 #include "firmware/core/stencil/contact_query.hpp"
@@ -17,10 +19,15 @@ struct HapticLimits {
 
 // How the wall feels beyond the coupling's spring (issue 29). All off by default: today's rendering,
 // a spring to the virtual tool that slips along the part without sticking.
+// How the virtual tool is kept to the speed the mill can follow: today's cap on its move per cycle
+// alone, or with a penalty on the hand too (damping that rises as the hand nears that speed, the
+// thesis's penalty-based speed limiting; the cap stays as the backstop).
+enum class SpeedLimiting : std::uint8_t { Cap, Penalty };
+
 struct WallFeel {
   // Virtual damping on the coupling (N s per device metre): resists the rate at which the coupling
-  // stretches or relaxes, so it acts in contact and wherever the tool lags the hand (the speed
-  // limit), not while the tool follows the hand freely.
+  // stretches or relaxes while the hand is in the wall; it may take the wall's push down to zero,
+  // never into a pull towards the part.
   double damping_n_s_per_m = 0.0;
   // The passivity observer and controller (passivity_controller.hpp): damping only where the wall
   // has put out more energy than it took.
@@ -32,6 +39,7 @@ struct WallFeel {
   // The device link's delay from command to motor (s): the passivity observer weighs the two last
   // commands by it for the force the device really held over the period.
   double transport_delay_s = 0.0;
+  SpeedLimiting speed_limiting = SpeedLimiting::Cap;
 };
 
 struct HapticOutput {
