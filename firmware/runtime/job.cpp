@@ -108,7 +108,8 @@ report::OperatorRecord operator_record_of(const Job& job, const RunOutcome& outc
   r.commands = job.records().commands();
   r.commands_unlisted = job.records().commands_unlisted();
   r.initial_limits = {config.haptic.coupling_n_per_device_mm, config.haptic.max_force_n,
-                      config.max_axis_move_mm / config.period_s};
+                      config.max_axis_move_mm / config.period_s, config.feel.damping_n_s_per_m, config.feel.friction,
+                      config.feel.speed_limiting};
   r.start_ns = outcome.start_ns;
   r.period_s = config.period_s;
   r.machine_holds = job.machine().statistics().holds;

@@ -747,6 +747,46 @@ TEST(Controller, ASpeedLimitNeverRaisesTheMillsAndALowerOneSlowsTheVirtualTool) 
   DOUBLES_EQUAL(0.25e-3, (bench.controller->virtual_tip_mm() - before).cwiseAbs().sum(), 1e-12);
 }
 
+// Issue 29: the wall's feel is the operator's like the other parameters: taken live, clamped to
+// what the cycle renders stably, and 0 means none (not a refusal).
+TEST(Controller, TheWallsDampingFrictionAndSpeedLimitingAreSetLiveAndClamped) {
+  Bench bench(config());
+  bench.cycles(5);
+  DOUBLES_EQUAL(0.0, bench.last_telemetry.damping_n_s_per_m, 0.0);
+  DOUBLES_EQUAL(0.0, bench.last_telemetry.friction, 0.0);
+  CHECK(bench.last_telemetry.speed_limiting == engine::SpeedLimiting::Cap);
+  const struct {
+    CommandKind kind;
+    double value;
+    ParameterOutcome outcome;
+    double damping, friction;
+    engine::SpeedLimiting limiting;
+  } steps[] = {
+      {CommandKind::SetDamping, 40.0, ParameterOutcome::Applied, 40.0, 0.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetDamping, 500.0, ParameterOutcome::Clamped, 100.0, 0.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetDamping, -1.0, ParameterOutcome::Refused, 100.0, 0.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetFriction, 0.3, ParameterOutcome::Applied, 100.0, 0.3, engine::SpeedLimiting::Cap},
+      {CommandKind::SetFriction, 1.5, ParameterOutcome::Clamped, 100.0, 1.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetFriction, std::numeric_limits<double>::quiet_NaN(), ParameterOutcome::Refused, 100.0, 1.0,
+       engine::SpeedLimiting::Cap},
+      {CommandKind::SetSpeedLimiting, 1.0, ParameterOutcome::Applied, 100.0, 1.0, engine::SpeedLimiting::Penalty},
+      {CommandKind::SetSpeedLimiting, 0.5, ParameterOutcome::Refused, 100.0, 1.0, engine::SpeedLimiting::Penalty},
+      {CommandKind::SetSpeedLimiting, 0.0, ParameterOutcome::Applied, 100.0, 1.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetFriction, 0.0, ParameterOutcome::Applied, 100.0, 0.0, engine::SpeedLimiting::Cap},
+      {CommandKind::SetDamping, 0.0, ParameterOutcome::Applied, 0.0, 0.0, engine::SpeedLimiting::Cap},
+  };
+  for (const auto& step : steps) {
+    CHECK(bench.display_commands.push({step.kind, step.value, CommandSource::Display}));
+    bench.cycles(1);
+    CHECK_TEXT(bench.last_telemetry.last_parameter == step.kind, command_kind_name(step.kind));
+    CHECK_TEXT(bench.last_telemetry.last_parameter_outcome == step.outcome, command_kind_name(step.kind));
+    DOUBLES_EQUAL(step.damping, bench.last_telemetry.damping_n_s_per_m, 0.0);
+    DOUBLES_EQUAL(step.friction, bench.last_telemetry.friction, 0.0);
+    CHECK(bench.last_telemetry.speed_limiting == step.limiting);
+  }
+  CHECK(bench.controller->safe_reason() == SafeReason::None);
+}
+
 // Issue 18, item 4: on the rig a handle resting 5 mm from the tool used to pull the tool (and the
 // mill) 30 ms after the spindle came on, with 5 N on the handle. A held start does nothing until the
 // hand is held as for a reset: still for the still time, near the tool.

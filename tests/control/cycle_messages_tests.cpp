@@ -39,7 +39,8 @@ TEST(CycleMessages, EachCommandKindSourceAndOutcomeHasItsOwnNameAndTheCountsCove
       names_below<CommandKind>(kCommandKindCount, [](CommandKind k) { return command_kind_name(k); });
   STRCMP_EQUAL("reset", kinds.front().c_str());
   STRCMP_EQUAL("journal_failed", kinds[2].c_str());
-  STRCMP_EQUAL("resume", kinds.back().c_str());
+  STRCMP_EQUAL("resume", kinds[7].c_str());  // the kinds journalled before the wall's feel keep their numbers
+  STRCMP_EQUAL("set_speed_limiting", kinds.back().c_str());
   const std::vector<std::string> sources =
       names_below<CommandSource>(kCommandSourceCount, [](CommandSource s) { return command_source_name(s); });
   STRCMP_EQUAL("cycle", sources.front().c_str());
@@ -65,10 +66,18 @@ TEST(CycleMessages, OnlyTheSetCommandsAreParametersAndEachNamesTheOneTheDisplayU
     const auto kind = static_cast<CommandKind>(value);
     const std::string name = parameter_name(kind);
     const bool set = kind == CommandKind::SetCoupling || kind == CommandKind::SetForceLimit ||
-                     kind == CommandKind::SetSpeedLimit;
+                     kind == CommandKind::SetSpeedLimit || kind == CommandKind::SetDamping ||
+                     kind == CommandKind::SetFriction || kind == CommandKind::SetSpeedLimiting;
     CHECK_TEXT(is_parameter(kind) == set, command_kind_name(kind));
     CHECK_TEXT((name != "none") == set, command_kind_name(kind));
+    // Zero is a value only where it means "none" (no damping, no friction, the cap alone).
+    const bool zero = kind == CommandKind::SetDamping || kind == CommandKind::SetFriction ||
+                      kind == CommandKind::SetSpeedLimiting;
+    CHECK_TEXT(zero_allowed(kind) == zero, command_kind_name(kind));
   }
+  STRCMP_EQUAL("damping", parameter_name(CommandKind::SetDamping));
+  STRCMP_EQUAL("friction", parameter_name(CommandKind::SetFriction));
+  STRCMP_EQUAL("speed_limiting", parameter_name(CommandKind::SetSpeedLimiting));
   STRCMP_EQUAL("coupling", parameter_name(CommandKind::SetCoupling));
   STRCMP_EQUAL("force_limit", parameter_name(CommandKind::SetForceLimit));
   STRCMP_EQUAL("speed_limit", parameter_name(CommandKind::SetSpeedLimit));

@@ -58,8 +58,8 @@ TEST(MessageCodec, EveryBadFieldIsNamedByItsByte) {
   m.kind = 99;
   STRCMP_CONTAINS("byte 6: unknown kind 99", decode_error(m).c_str());
   m = make_set(Parameter::Coupling, 1.0, 1);
-  m.parameter = 3;
-  STRCMP_CONTAINS("byte 7: unknown parameter 3", decode_error(m).c_str());
+  m.parameter = 6;
+  STRCMP_CONTAINS("byte 7: unknown parameter 6 (0 to 5)", decode_error(m).c_str());
   m = make_message(MessageKind::Reset, 1);
   m.parameter = 1;
   STRCMP_CONTAINS("byte 7: expected 0 outside a Set", decode_error(m).c_str());

@@ -108,3 +108,32 @@ TEST(RequestRules, AResetMayBeAskedOnlyInASafeStateWithTheHandleStillNearTheTool
   STRCMP_EQUAL("", reset_refusal(true, t, rule).c_str());
   STRCMP_CONTAINS("not in a safe state", reset_refusal(false, t, rule).c_str());  // no telemetry yet
 }
+
+// Issue 29: the wall's feel. Zero is a value (none, the cap alone), the damping is bounded by what
+// the cycle renders stably, friction is a coefficient of 0 to 1, the speed limiting 0 or 1.
+TEST(RequestRules, TheWallsFeelTakesZeroAndIsBoundedByItsOwnRange) {
+  RequestLimits limits;
+  limits.max_damping_n_s_per_m = 100.0;
+  CHECK(command_kind(Parameter::Damping) == control::CommandKind::SetDamping);
+  CHECK(command_kind(Parameter::Friction) == control::CommandKind::SetFriction);
+  CHECK(command_kind(Parameter::SpeedLimiting) == control::CommandKind::SetSpeedLimiting);
+  STRCMP_EQUAL("N s/m", parameter_unit(Parameter::Damping));
+  for (const Parameter p : {Parameter::Damping, Parameter::Friction, Parameter::SpeedLimiting}) {
+    CHECK(refusal({RequestKind::Set, p, 0.0}, limits).empty());
+    CHECK(refusal({RequestKind::Set, p, 1.0}, limits).empty());
+    CHECK_FALSE(refusal({RequestKind::Set, p, -0.5}, limits).empty());
+    CHECK_FALSE(refusal({RequestKind::Set, p, std::nan("")}, limits).empty());
+  }
+  CHECK(refusal({RequestKind::Set, Parameter::Damping, 100.0}, limits).empty());
+  STRCMP_EQUAL("150 N s/m is above the most damping the cycle renders stably, 100 N s/m",
+               refusal({RequestKind::Set, Parameter::Damping, 150.0}, limits).c_str());
+  STRCMP_EQUAL("damping must be a number of at least 0", refusal({RequestKind::Set, Parameter::Damping, -1.0}, limits).c_str());
+  CHECK(refusal({RequestKind::Set, Parameter::Friction, 0.5}, limits).empty());
+  STRCMP_EQUAL("a friction coefficient of 1.2 is outside 0 to 1",
+               refusal({RequestKind::Set, Parameter::Friction, 1.2}, limits).c_str());
+  STRCMP_EQUAL("speed limiting 0.5: expected 0 (the cap) or 1 (the penalty)",
+               refusal({RequestKind::Set, Parameter::SpeedLimiting, 0.5}, limits).c_str());
+  const control::Command penalty = command_of({RequestKind::Set, Parameter::SpeedLimiting, 1.0});
+  CHECK(penalty.kind == control::CommandKind::SetSpeedLimiting);
+  DOUBLES_EQUAL(1.0, penalty.value, 0.0);
+}

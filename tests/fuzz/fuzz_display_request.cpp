@@ -45,7 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const std::string refused = refusal(request, limits);
     const stencil::control::Command command = command_of(request);
     if (request.kind == RequestKind::Set && refused.empty()) {
-      require(request.value > 0.0);
+      require(request.value > 0.0 || (request.value == 0.0 && stencil::control::zero_allowed(command.kind)));
       switch (request.parameter) {
         case Parameter::ForceLimit:
           require(request.value <= limits.board_force_limit_n && command.kind == stencil::control::CommandKind::SetForceLimit);
@@ -57,6 +57,16 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           require(request.value >= limits.min_coupling_n_per_device_mm &&
                   request.value <= limits.max_coupling_n_per_device_mm &&
                   command.kind == stencil::control::CommandKind::SetCoupling);
+          break;
+        case Parameter::Damping:
+          require(request.value <= limits.max_damping_n_s_per_m && command.kind == stencil::control::CommandKind::SetDamping);
+          break;
+        case Parameter::Friction:
+          require(request.value <= 1.0 && command.kind == stencil::control::CommandKind::SetFriction);
+          break;
+        case Parameter::SpeedLimiting:
+          require((request.value == 0.0 || request.value == 1.0) &&
+                  command.kind == stencil::control::CommandKind::SetSpeedLimiting);
           break;
       }
     }

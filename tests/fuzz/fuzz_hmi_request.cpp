@@ -40,7 +40,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const HmiLimits limits;
   const std::string refused = refusal(request, limits);
   if (request.kind == RequestKind::Set && refused.empty()) {
-    require(std::isfinite(request.value) && request.value > 0.0);
+    require(std::isfinite(request.value) &&
+            (request.value > 0.0 || (request.value == 0.0 && stencil::control::zero_allowed(command_kind(request.parameter)))));
     switch (request.parameter) {
       case Parameter::ForceLimit:
         require(request.value <= limits.board_force_limit_n);
@@ -50,6 +51,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
         break;
       case Parameter::Coupling:
         require(request.value >= limits.min_coupling_n_per_device_mm && request.value <= limits.max_coupling_n_per_device_mm);
+        break;
+      case Parameter::Damping:
+        require(request.value <= limits.max_damping_n_s_per_m);
+        break;
+      case Parameter::Friction:
+        require(request.value <= 1.0);
+        break;
+      case Parameter::SpeedLimiting:
+        require(request.value == 0.0 || request.value == 1.0);
         break;
     }
   }

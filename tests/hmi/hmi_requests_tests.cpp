@@ -68,7 +68,12 @@ TEST(HmiRequests, ASetWithoutANumberNamesTheParameterAndItsUnit) {
   CHECK_FALSE(parse_request(R"({"type":"set","name":"coupling","value":[1]})", r, error));
   STRCMP_EQUAL("\"set\" coupling needs a number \"value\" in N/mm", error.c_str());
   CHECK_FALSE(parse_request(R"({"type":"set","name":"torque","value":1})", r, error));
-  STRCMP_EQUAL("unknown parameter 'torque': expected coupling, force_limit or speed_limit", error.c_str());
+  STRCMP_EQUAL("unknown parameter 'torque': expected coupling, force_limit, speed_limit, damping, friction or speed_limiting",
+               error.c_str());
+  CHECK_FALSE(parse_request(R"({"type":"set","name":"friction"})", r, error));
+  STRCMP_EQUAL("\"set\" friction needs a number \"value\"", error.c_str());
+  CHECK_FALSE(parse_request(R"({"type":"set","name":"damping","value":"5"})", r, error));
+  STRCMP_EQUAL("\"set\" damping needs a number \"value\" in N s/m", error.c_str());
   // A name the size of the message is not echoed whole.
   const std::string long_name = std::string(60, 'n');
   CHECK_FALSE(parse_request(R"({"type":")" + long_name + R"("})", r, error));
@@ -83,4 +88,22 @@ TEST(HmiRequests, ASetWithoutANumberNamesTheParameterAndItsUnit) {
   CHECK(r.kind == RequestKind::Reset);
   CHECK_FALSE(parse_request(pad + std::string(kMaxRequestBytes - pad.size() - 1, 'x') + "\"}", r, error));
   STRCMP_EQUAL("message of 1025 bytes: at most 1024", error.c_str());
+}
+
+// The speed limiting by its name (the page's select) or its number; anything else is named back.
+TEST(HmiRequests, TheSpeedLimitingIsSetByNameOrNumber) {
+  Request r;
+  std::string error;
+  CHECK(parse_request(R"({"type":"set","name":"speed_limiting","value":"penalty"})", r, error));
+  CHECK(r.kind == RequestKind::Set && r.parameter == Parameter::SpeedLimiting);
+  DOUBLES_EQUAL(1.0, r.value, 0.0);
+  CHECK(parse_request(R"({"type":"set","name":"speed_limiting","value":"cap"})", r, error));
+  DOUBLES_EQUAL(0.0, r.value, 0.0);
+  CHECK(parse_request(R"({"type":"set","name":"speed_limiting","value":1})", r, error));
+  DOUBLES_EQUAL(1.0, r.value, 0.0);
+  CHECK_FALSE(parse_request(R"({"type":"set","name":"speed_limiting","value":"brake"})", r, error));
+  STRCMP_EQUAL("speed_limiting 'brake': expected \"cap\" or \"penalty\" (or 0 or 1)", error.c_str());
+  CHECK(parse_request(R"({"type":"set","name":"friction","value":0.4})", r, error));
+  CHECK(r.parameter == Parameter::Friction);
+  DOUBLES_EQUAL(0.4, r.value, 0.0);
 }

@@ -253,6 +253,6 @@ TEST(JournalReader, ACommandRecordOutOfRangeIsAnErrorNamingTheOffset) {
   }
   const JournalReadResult read = read_journal(bytes.data(), bytes.size(), {});
   CHECK_FALSE(read.ok);
-  STRCMP_CONTAINS(("journal offset " + std::to_string(at + 5 + 24) + ": a command record's kind is 99 (expected below 8)").c_str(),
+  STRCMP_CONTAINS(("journal offset " + std::to_string(at + 5 + 24) + ": a command record's kind is 99 (expected below 11)").c_str(),
                   read.error.c_str());
 }

@@ -56,7 +56,7 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
 }
 
 ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
-  if (!std::isfinite(value) || value <= 0.0) {
+  if (!std::isfinite(value) || value < 0.0 || (value == 0.0 && !zero_allowed(kind))) {
     return ParameterOutcome::Refused;
   }
   switch (kind) {
@@ -79,6 +79,24 @@ ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
       return per_step_mm <= board_axis_move_mm_ && per_step_mm <= board_total_move_mm_ ? ParameterOutcome::Applied
                                                                                         : ParameterOutcome::Clamped;
     }
+    case CommandKind::SetDamping: {
+      const double applied = std::min(value, config_.max_damping_n_s_per_m);
+      config_.feel.damping_n_s_per_m = applied;
+      // The passivity controller goes with the damping: on, it takes back what the damper's delay
+      // and the sampling put in; off, today's rendering exactly.
+      config_.feel.passivity = applied > 0.0;
+      return applied == value ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetFriction: {
+      config_.feel.friction = std::min(value, 1.0);
+      return value <= 1.0 ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
+    }
+    case CommandKind::SetSpeedLimiting:
+      if (value != 0.0 && value != 1.0) {
+        return ParameterOutcome::Refused;
+      }
+      config_.feel.speed_limiting = value == 0.0 ? engine::SpeedLimiting::Cap : engine::SpeedLimiting::Penalty;
+      return ParameterOutcome::Applied;
     default:
       return ParameterOutcome::Refused;
   }
@@ -177,6 +195,12 @@ double Controller::parameter_value(CommandKind kind) const {
       return config_.haptic.max_force_n;
     case CommandKind::SetSpeedLimit:
       return config_.max_axis_move_mm / config_.period_s;
+    case CommandKind::SetDamping:
+      return config_.feel.damping_n_s_per_m;
+    case CommandKind::SetFriction:
+      return config_.feel.friction;
+    case CommandKind::SetSpeedLimiting:
+      return config_.feel.speed_limiting == engine::SpeedLimiting::Penalty ? 1.0 : 0.0;
     default:
       return 0.0;
   }
@@ -206,6 +230,9 @@ CommandOutcome Controller::take_command(const Command& command, hal::MonotonicNs
     case CommandKind::SetCoupling:
     case CommandKind::SetForceLimit:
     case CommandKind::SetSpeedLimit:
+    case CommandKind::SetDamping:
+    case CommandKind::SetFriction:
+    case CommandKind::SetSpeedLimiting:
       last_parameter_ = command.kind;
       last_parameter_outcome_ = set_parameter(command.kind, command.value);
       ++parameter_requests_;
@@ -637,6 +664,9 @@ Telemetry Controller::build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs 
   telemetry.coupling_n_per_device_mm = config_.haptic.coupling_n_per_device_mm;
   telemetry.force_limit_n = config_.haptic.max_force_n;
   telemetry.speed_limit_mm_per_s = config_.max_axis_move_mm / config_.period_s;
+  telemetry.damping_n_s_per_m = config_.feel.damping_n_s_per_m;
+  telemetry.friction = config_.feel.friction;
+  telemetry.speed_limiting = config_.feel.speed_limiting;
   telemetry.parameter_requests = parameter_requests_;
   telemetry.last_parameter = last_parameter_;
   telemetry.last_parameter_outcome = last_parameter_outcome_;

@@ -58,6 +58,11 @@ struct ControllerConfig {
   // speed limit only ever below the board's (haptic.max_force_n and the move limits above).
   double min_coupling_n_per_device_mm = 0.05;
   double max_coupling_n_per_device_mm = 2.0;
+  // The most virtual damping the operator may set (N s per device metre). The wall test's damping
+  // at the stiffest coupling is 10 + 21 x 3 = 73; a damper sampled at 1 kHz on the device's 0.2 kg
+  // alone stays stable below 2 m / T = 400, so this leaves the hand's own mass and the velocity
+  // filter's lag a margin of four.
+  double max_damping_n_s_per_m = 100.0;
 };
 
 // How near the real tool's surface a point of the part counts as touched: the tolerance beyond the

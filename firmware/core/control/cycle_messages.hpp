@@ -8,6 +8,7 @@
 
 #include "firmware/core/control/safe_state.hpp"
 #include "firmware/core/control/spsc_ring.hpp"
+#include "firmware/core/stencil/haptic_force.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "hal/haptic_device.hpp"
 #include "hal/machine_link.hpp"
@@ -27,6 +28,12 @@ enum class CommandKind : std::uint8_t {
   // holds where it is; Resume carries on from there, without a reset or homing.
   Pause,
   Resume,
+  // The wall's feel (issue 29; engine::WallFeel), operator's parameters like the three above. Last,
+  // so that the kinds journalled before them keep their numbers.
+  SetDamping,        // N s per device metre of virtual damping in the wall, 0 (none) to the config's most;
+                     // the passivity controller runs while it is above 0
+  SetFriction,       // the Coulomb friction coefficient of the virtual tool on the part, 0 to 1
+  SetSpeedLimiting,  // 0: the cap on the virtual tool's speed alone; 1: with the penalty on the hand too
 };
 
 // Where a command (and so a safe state) came from, for the journal, the report and the display.
@@ -91,18 +98,32 @@ struct Command {
       return "pause";
     case CommandKind::Resume:
       return "resume";
+    case CommandKind::SetDamping:
+      return "set_damping";
+    case CommandKind::SetFriction:
+      return "set_friction";
+    case CommandKind::SetSpeedLimiting:
+      return "set_speed_limiting";
   }
   return "unknown";
 }
-inline constexpr std::uint8_t kCommandKindCount = 8;
+inline constexpr std::uint8_t kCommandKindCount = 11;
 
 // Whether the command sets one of the operator's parameters.
 [[nodiscard]] constexpr bool is_parameter(CommandKind kind) {
-  return kind == CommandKind::SetCoupling || kind == CommandKind::SetForceLimit || kind == CommandKind::SetSpeedLimit;
+  return kind == CommandKind::SetCoupling || kind == CommandKind::SetForceLimit || kind == CommandKind::SetSpeedLimit ||
+         kind == CommandKind::SetDamping || kind == CommandKind::SetFriction || kind == CommandKind::SetSpeedLimiting;
+}
+
+// Whether 0 is one of the parameter's values (no damping, no friction, the cap alone) rather than
+// a refusal.
+[[nodiscard]] constexpr bool zero_allowed(CommandKind kind) {
+  return kind == CommandKind::SetDamping || kind == CommandKind::SetFriction || kind == CommandKind::SetSpeedLimiting;
 }
 
 // The operator's parameter a Set* command sets, by the name the display uses in its requests and
-// its state feed ("coupling", "force_limit", "speed_limit"); "none" for the other commands.
+// its state feed ("coupling", "force_limit", "speed_limit", "damping", "friction", "speed_limiting");
+// "none" for the other commands.
 [[nodiscard]] constexpr const char* parameter_name(CommandKind kind) {
   switch (kind) {
     case CommandKind::SetCoupling:
@@ -111,6 +132,12 @@ inline constexpr std::uint8_t kCommandKindCount = 8;
       return "force_limit";
     case CommandKind::SetSpeedLimit:
       return "speed_limit";
+    case CommandKind::SetDamping:
+      return "damping";
+    case CommandKind::SetFriction:
+      return "friction";
+    case CommandKind::SetSpeedLimiting:
+      return "speed_limiting";
     case CommandKind::Reset:
     case CommandKind::Stop:
     case CommandKind::JournalFailed:
@@ -126,7 +153,8 @@ enum class ParameterOutcome : std::uint8_t {
   None,     // none taken yet
   Applied,  // as asked
   Clamped,  // above the board's limit (or below the least): the limit applies instead
-  Refused,  // not a finite positive number: nothing changed
+  Refused,  // not a finite positive number (damping, friction: not finite or below 0; speed limiting:
+            // neither 0 nor 1): nothing changed
 };
 
 [[nodiscard]] constexpr const char* parameter_outcome_name(ParameterOutcome outcome) {
@@ -173,7 +201,7 @@ enum class ResetOutcome : std::uint8_t {
 enum class CommandOutcome : std::uint8_t {
   Done,               // Stop: the safe state entered; Pause, Resume: done; Reset: accepted; Set*: applied as asked
   Clamped,            // Set*: the board's limit (or the least) applies instead
-  Refused,            // Set*: not a finite positive number, nothing changed
+  Refused,            // Set*: not a number the parameter can take, nothing changed
   AlreadySafe,        // Stop, JournalFailed: the safe state was latched already (its first reason stays)
   NotInSafeState,     // Reset: nothing to reset
   DeviceNotStill,     // Reset: see ResetOutcome
@@ -281,6 +309,9 @@ struct Telemetry {
   double coupling_n_per_device_mm;
   double force_limit_n;
   double speed_limit_mm_per_s;   // infinity: unlimited
+  double damping_n_s_per_m;
+  double friction;
+  engine::SpeedLimiting speed_limiting;
   std::uint32_t parameter_requests;
   CommandKind last_parameter;
   ParameterOutcome last_parameter_outcome;

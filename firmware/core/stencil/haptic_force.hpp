@@ -23,6 +23,9 @@ struct HapticLimits {
 // alone, or with a penalty on the hand too (damping that rises as the hand nears that speed, the
 // thesis's penalty-based speed limiting; the cap stays as the backstop).
 enum class SpeedLimiting : std::uint8_t { Cap, Penalty };
+[[nodiscard]] constexpr const char* speed_limiting_name(SpeedLimiting mode) {
+  return mode == SpeedLimiting::Penalty ? "penalty" : "cap";
+}
 
 struct WallFeel {
   // Virtual damping on the coupling (N s per device metre): resists the rate at which the coupling

@@ -34,6 +34,7 @@ RequestLimits limits_of(const control::ControllerConfig& config) {
   limits.mill_speed_mm_per_s = std::min(config.max_axis_move_mm, config.max_total_move_mm) / config.period_s;
   limits.min_coupling_n_per_device_mm = config.min_coupling_n_per_device_mm;
   limits.max_coupling_n_per_device_mm = config.max_coupling_n_per_device_mm;
+  limits.max_damping_n_s_per_m = config.max_damping_n_s_per_m;
   return limits;
 }
 
@@ -82,6 +83,9 @@ DisplayLink::DisplayLink(const tables::PartTables& part, const control::Controll
   t.coupling_n_per_device_mm = config.haptic.coupling_n_per_device_mm;
   t.force_limit_n = config.haptic.max_force_n;
   t.speed_limit_mm_per_s = config.max_axis_move_mm / config.period_s;
+  t.damping_n_s_per_m = config.feel.damping_n_s_per_m;
+  t.friction = config.feel.friction;
+  t.speed_limiting = config.feel.speed_limiting;
 }
 
 DisplayLink::~DisplayLink() { stop(); }

@@ -23,7 +23,7 @@
 namespace stencil::display_link {
 
 // Any change to a Message or to the feed's layout changes this.
-inline constexpr std::uint16_t kProtocolVersion = 3;
+inline constexpr std::uint16_t kProtocolVersion = 4;  // 4: the wall's feel (damping, friction, speed limiting)
 
 // ---- the request channel ----
 

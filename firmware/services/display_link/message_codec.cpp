@@ -52,7 +52,7 @@ DecodeResult decode_message(const unsigned char* bytes, std::size_t size, Messag
                             : kind == MessageKind::Hello ? kHelloControl
                                                          : 0;
   if (message.parameter > most) {
-    error = at(offsetof(Message, parameter), kind == MessageKind::Set     ? "unknown parameter " + std::to_string(message.parameter) + " (0 to 2)"
+    error = at(offsetof(Message, parameter), kind == MessageKind::Set     ? "unknown parameter " + std::to_string(message.parameter) + " (0 to " + std::to_string(kParameterCount - 1) + ")"
                                              : kind == MessageKind::Hello ? "who says hello: expected 0 (a display) or 1 (a control command)"
                                                                           : "expected 0 outside a Set and a Hello");
     return DecodeResult::Malformed;

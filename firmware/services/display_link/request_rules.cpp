@@ -24,6 +24,11 @@ const char* parameter_unit(Parameter parameter) {
       return "N";
     case Parameter::SpeedLimit:
       return "mm/s";
+    case Parameter::Damping:
+      return "N s/m";
+    case Parameter::Friction:
+    case Parameter::SpeedLimiting:
+      return "";
   }
   return "";
 }
@@ -36,6 +41,12 @@ control::CommandKind command_kind(Parameter parameter) {
       return control::CommandKind::SetForceLimit;
     case Parameter::SpeedLimit:
       return control::CommandKind::SetSpeedLimit;
+    case Parameter::Damping:
+      return control::CommandKind::SetDamping;
+    case Parameter::Friction:
+      return control::CommandKind::SetFriction;
+    case Parameter::SpeedLimiting:
+      return control::CommandKind::SetSpeedLimiting;
   }
   return control::CommandKind::SetCoupling;
 }
@@ -65,8 +76,13 @@ std::string refusal(const Request& request, const RequestLimits& limits) {
   }
   const double value = request.value;
   const std::string unit = parameter_unit(request.parameter);
-  if (!std::isfinite(value) || value <= 0.0) {
-    return std::string(control::parameter_name(command_kind(request.parameter))) + " must be a positive number of " + unit;
+  const control::CommandKind kind = command_kind(request.parameter);
+  if (control::zero_allowed(kind)) {
+    if (!std::isfinite(value) || value < 0.0) {
+      return std::string(control::parameter_name(kind)) + " must be a number of at least 0";
+    }
+  } else if (!std::isfinite(value) || value <= 0.0) {
+    return std::string(control::parameter_name(kind)) + " must be a positive number of " + unit;
   }
   switch (request.parameter) {
     case Parameter::Coupling:
@@ -84,6 +100,22 @@ std::string refusal(const Request& request, const RequestLimits& limits) {
     case Parameter::SpeedLimit:
       if (value > limits.mill_speed_mm_per_s) {
         return number(value) + " mm/s is above what the mill follows, " + number(limits.mill_speed_mm_per_s) + " mm/s";
+      }
+      break;
+    case Parameter::Damping:
+      if (value > limits.max_damping_n_s_per_m) {
+        return number(value) + " N s/m is above the most damping the cycle renders stably, " +
+               number(limits.max_damping_n_s_per_m) + " N s/m";
+      }
+      break;
+    case Parameter::Friction:
+      if (value > 1.0) {
+        return "a friction coefficient of " + number(value) + " is outside 0 to 1";
+      }
+      break;
+    case Parameter::SpeedLimiting:
+      if (value != 0.0 && value != 1.0) {
+        return "speed limiting " + number(value) + ": expected 0 (the cap) or 1 (the penalty)";
       }
       break;
   }

@@ -12,8 +12,8 @@ namespace stencil::display_link {
 
 // Start is not a cycle command: it answers the program waiting to turn the spindle on (never the ring).
 enum class RequestKind : std::uint8_t { Set, Reset, Stop, Pause, Resume, Start };
-enum class Parameter : std::uint8_t { Coupling, ForceLimit, SpeedLimit };
-inline constexpr int kParameterCount = 3;
+enum class Parameter : std::uint8_t { Coupling, ForceLimit, SpeedLimit, Damping, Friction, SpeedLimiting };
+inline constexpr int kParameterCount = 6;
 
 struct Request {
   RequestKind kind = RequestKind::Reset;
@@ -28,6 +28,7 @@ struct RequestLimits {
   double mill_speed_mm_per_s = 1.0;
   double min_coupling_n_per_device_mm = 0.05;
   double max_coupling_n_per_device_mm = 2.0;
+  double max_damping_n_s_per_m = 100.0;
 };
 
 // The cycle's reset rule, as far as the threads around it can see it from its telemetry.
@@ -36,7 +37,8 @@ struct ResetRule {
   double reset_distance_mm = 2.0;
 };
 
-[[nodiscard]] const char* parameter_unit(Parameter parameter);  // "N/mm", "N", "mm/s"
+// "N/mm", "N", "mm/s", "N s/m", "" (friction: a coefficient), "" (speed limiting: 0 cap, 1 penalty)
+[[nodiscard]] const char* parameter_unit(Parameter parameter);
 // The command that sets it; its name is control::parameter_name(command_kind(parameter)).
 [[nodiscard]] control::CommandKind command_kind(Parameter parameter);
 [[nodiscard]] control::Command command_of(const Request& request);

@@ -211,6 +211,9 @@ void LiveState::common(nlohmann::json& out) const {
                    {"speed_limit", std::isfinite(telemetry.speed_limit_mm_per_s)
                                        ? nlohmann::json(rounded(telemetry.speed_limit_mm_per_s, 1e-4))
                                        : nlohmann::json(nullptr)},
+                   {"damping", rounded(telemetry.damping_n_s_per_m, 1e-4)},
+                   {"friction", rounded(telemetry.friction, 1e-4)},
+                   {"speed_limiting", engine::speed_limiting_name(telemetry.speed_limiting)},
                    {"requests", telemetry.parameter_requests},
                    {"last", control::parameter_name(telemetry.last_parameter)},
                    {"last_outcome", control::parameter_outcome_name(telemetry.last_parameter_outcome)}};
@@ -302,7 +305,8 @@ nlohmann::json LiveState::snapshot(std::uint64_t sequence, const nlohmann::json&
   out["limits"] = {{"board_force_limit", limits_.board_force_limit_n},
                    {"mill_speed", limits_.mill_speed_mm_per_s},
                    {"min_coupling", limits_.min_coupling_n_per_device_mm},
-                   {"max_coupling", limits_.max_coupling_n_per_device_mm}};
+                   {"max_coupling", limits_.max_coupling_n_per_device_mm},
+                   {"max_damping", limits_.max_damping_n_s_per_m}};
   out["server"] = server;
   return out;
 }

@@ -38,25 +38,38 @@ bool parse_request(std::string_view text, Request& request, std::string& error) 
     error = "unknown \"type\" '" + type.substr(0, 40) + "': expected \"set\", \"reset\", \"stop\", \"pause\" or \"resume\"";
     return false;
   }
+  constexpr const char* kNames = "coupling, force_limit, speed_limit, damping, friction or speed_limiting";
   if (!message.contains("name") || !message["name"].is_string()) {
-    error = "\"set\" needs a string \"name\": coupling, force_limit or speed_limit";
+    error = std::string("\"set\" needs a string \"name\": ") + kNames;
     return false;
   }
   const std::string name = message["name"].get<std::string>();
   Parameter parameter{};
-  if (name == "coupling") {
-    parameter = Parameter::Coupling;
-  } else if (name == "force_limit") {
-    parameter = Parameter::ForceLimit;
-  } else if (name == "speed_limit") {
-    parameter = Parameter::SpeedLimit;
-  } else {
-    error = "unknown parameter '" + name.substr(0, 40) + "': expected coupling, force_limit or speed_limit";
+  bool known = false;
+  for (int p = 0; p < display_link::kParameterCount; ++p) {
+    if (name == control::parameter_name(command_kind(static_cast<Parameter>(p)))) {
+      parameter = static_cast<Parameter>(p);
+      known = true;
+    }
+  }
+  if (!known) {
+    error = "unknown parameter '" + name.substr(0, 40) + "': expected " + kNames;
     return false;
   }
+  // The speed limiting by its name as well as its number: "cap" (0) or "penalty" (1).
+  if (parameter == Parameter::SpeedLimiting && message.contains("value") && message["value"].is_string()) {
+    const std::string mode = message["value"].get<std::string>();
+    if (mode != "cap" && mode != "penalty") {
+      error = "speed_limiting '" + mode.substr(0, 40) + "': expected \"cap\" or \"penalty\" (or 0 or 1)";
+      return false;
+    }
+    request = Request{RequestKind::Set, parameter, mode == "cap" ? 0.0 : 1.0};
+    return true;
+  }
   if (!message.contains("value") || !message["value"].is_number()) {
-    error = std::string("\"set\" ") + control::parameter_name(command_kind(parameter)) + " needs a number \"value\" in " +
-            parameter_unit(parameter);
+    const std::string unit = parameter_unit(parameter);
+    error = std::string("\"set\" ") + control::parameter_name(command_kind(parameter)) + " needs a number \"value\"" +
+            (unit.empty() ? std::string() : " in " + unit);
     return false;
   }
   request = Request{RequestKind::Set, parameter, message["value"].get<double>()};

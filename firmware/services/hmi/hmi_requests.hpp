@@ -2,7 +2,8 @@
 // stencil-display, and checked against the controller's limits before it goes to the controller
 // (which checks again: display_link/request_rules.hpp).
 //
-//   {"type":"set","name":"coupling"|"force_limit"|"speed_limit","value":N}
+//   {"type":"set","name":"coupling"|"force_limit"|"speed_limit"|"damping"|"friction","value":N}
+//   {"type":"set","name":"speed_limiting","value":"cap"|"penalty"}   (or 0 or 1)
 //   {"type":"reset"}
 #pragma once
 

@@ -65,7 +65,10 @@ nlohmann::json limits_json(std::uint64_t from_cycle, double from_s, const Operat
           {"from_s", from_s},
           {"coupling_n_per_device_mm", limits.coupling_n_per_device_mm},
           {"force_limit_n", limits.force_limit_n},
-          {"speed_limit_mm_per_s", finite_or_null(limits.speed_limit_mm_per_s)}};
+          {"speed_limit_mm_per_s", finite_or_null(limits.speed_limit_mm_per_s)},
+          {"damping_n_s_per_m", limits.damping_n_s_per_m},
+          {"friction", limits.friction},
+          {"speed_limiting", engine::speed_limiting_name(limits.speed_limiting)}};
 }
 
 // The commands in order, the limits in force from each change on, the pauses and the positions.
@@ -92,9 +95,26 @@ nlohmann::json operator_json(const OperatorRecord& r, control::SafeReason safe_s
     list.push_back(item);
     pauses += e.kind == control::CommandKind::Pause && e.outcome == control::CommandOutcome::Done ? 1 : 0;
     if (set && e.outcome != control::CommandOutcome::Refused) {
-      (e.kind == control::CommandKind::SetCoupling     ? now.coupling_n_per_device_mm
-       : e.kind == control::CommandKind::SetForceLimit ? now.force_limit_n
-                                                       : now.speed_limit_mm_per_s) = e.applied;
+      switch (e.kind) {
+        case control::CommandKind::SetCoupling:
+          now.coupling_n_per_device_mm = e.applied;
+          break;
+        case control::CommandKind::SetForceLimit:
+          now.force_limit_n = e.applied;
+          break;
+        case control::CommandKind::SetDamping:
+          now.damping_n_s_per_m = e.applied;
+          break;
+        case control::CommandKind::SetFriction:
+          now.friction = e.applied;
+          break;
+        case control::CommandKind::SetSpeedLimiting:
+          now.speed_limiting = e.applied == 0.0 ? engine::SpeedLimiting::Cap : engine::SpeedLimiting::Penalty;
+          break;
+        default:
+          now.speed_limit_mm_per_s = e.applied;
+          break;
+      }
       limits.push_back(limits_json(e.cycle, t_s, now));
     }
   }

@@ -30,6 +30,10 @@ struct OperatorLimits {
   double coupling_n_per_device_mm = 0.0;
   double force_limit_n = 0.0;
   double speed_limit_mm_per_s = 0.0;  // infinity: unlimited
+  // The wall's feel (engine::WallFeel): N s per device metre, 0 to 1, and the speed-limiting mode.
+  double damping_n_s_per_m = 0.0;
+  double friction = 0.0;
+  engine::SpeedLimiting speed_limiting = engine::SpeedLimiting::Cap;
 };
 
 // Where everything stood when the run ended: a machine's position readout, in millimetres.

@@ -1,5 +1,6 @@
 // The operator's controls end to end in real headless Chromium: stencil-sim --speed 5 --hmi on a
-// raster job with a journal; on the page three parameter changes, a Pause held for a while, Resume,
+// raster job with a journal; on the page six parameter changes (the three limits and the wall's
+// damping, friction and speed limiting), a Pause held for a while, Resume,
 // then Stop. Checked against the journal (read here, byte by byte, as journal_format.hpp lays it out)
 // and the report:
 //  - the cycle that took the Stop is the safe state's (its SafeState record, source display), at
@@ -8,7 +9,7 @@
 //  - while paused no machine command was planned and the virtual tool stayed put; Resume carried
 //    on; no gouge, no safe state before the Stop;
 //  - the readout on the page at the end matches the report's final positions within 0.001 mm;
-//  - stencil-sim --replay of the journal: 0 cycles differ, and its report lists the three changes.
+//  - stencil-sim --replay of the journal: 0 cycles differ, and its report lists the six changes.
 //
 //   node hmi_operator.cjs STENCIL_SIM ASSETS_DIR WORK_DIR
 // (NODE_PATH must reach the page's node_modules, for playwright-core.)
@@ -29,7 +30,8 @@ const journalPath = path.join(workDir, 'job.journal');
 const reportPath = path.join(workDir, 'report.json');
 
 const UPDATE_NS = 1e9 / 30;  // the machine update (rig_facts.hpp)
-const KIND = ['reset', 'stop', 'journal_failed', 'set_coupling', 'set_force_limit', 'set_speed_limit', 'pause', 'resume'];
+const KIND = ['reset', 'stop', 'journal_failed', 'set_coupling', 'set_force_limit', 'set_speed_limit', 'pause', 'resume',
+  'set_damping', 'set_friction', 'set_speed_limiting'];
 const SOURCE = ['cycle', 'machine', 'program', 'signal', 'terminal', 'display', 'replay', 'control'];
 
 function fail(message) {
@@ -101,7 +103,11 @@ function startSim() {
 const droText = (page, row) => page.$$eval(`#dro-${row} td`, (cells) => cells.map((c) => c.textContent));
 
 async function setParameter(page, input, name, value) {
-  await page.fill(input, String(value));
+  if (typeof value === 'string') {
+    await page.selectOption(input, value);  // the speed limiting: a select
+  } else {
+    await page.fill(input, String(value));
+  }
   await page.click(`button[data-name="${name}"]`);
   await page.waitForFunction((n) => [...document.querySelectorAll('#events li')].some((li) => li.textContent.includes(`${n} asked`)),
     name, { timeout: 15000 });
@@ -129,11 +135,17 @@ async function setParameter(page, input, name, value) {
       null, { timeout: 30000 });
     await page.waitForFunction(() => Number(document.body.dataset.t) > 3, null, { timeout: 30000 });
 
-    // Three parameter changes, each in the event list with the value asked and the value in force.
+    // Six parameter changes, each in the event list with the value asked and the value in force: the
+    // three limits and the wall's feel (issue 29), which the replay must give back exactly too.
     await setParameter(page, '#coupling', 'coupling', 0.8);
     await setParameter(page, '#force-limit', 'force_limit', 4);
     await setParameter(page, '#speed-limit', 'speed_limit', 0.8);
-    console.log(`after three changes: ${await page.textContent('#in-force')}`);
+    await setParameter(page, '#damping', 'damping', 30);
+    await setParameter(page, '#friction', 'friction', 0.3);
+    await setParameter(page, '#speed-limiting', 'speed_limiting', 'penalty');
+    await page.waitForFunction(() => /\(penalty\), damping 30\.0 N s\/m, friction 0\.30/.test(document.getElementById('in-force').textContent),
+      null, { timeout: 10000 });
+    console.log(`after six changes: ${await page.textContent('#in-force')}`);
 
     // Pause: the tool and the mill held, on the page too.
     await page.click('#pause');
@@ -239,11 +251,15 @@ async function setParameter(page, input, name, value) {
   console.log(`readout vs report: largest difference ${worst.toFixed(4)} mm over 15 values`);
   if (!(worst <= 0.001)) fail(`the readout differs from the report by ${worst} mm: ${JSON.stringify(page_dro)} vs ${JSON.stringify(expected)}`);
 
-  // Three changes in the report, each with the value asked and applied; the limits from when.
+  // Six changes in the report, each with the value asked and applied; the limits from when.
   const changes = report.commands.list.filter((c) => c.parameter);
   console.log(`report: ${changes.map((c) => `${c.parameter} ${c.asked} -> ${c.applied} (${c.outcome}) at ${c.t_s.toFixed(3)} s`).join('; ')}; ` +
     `${report.limits.length} limit sets`);
-  if (changes.length !== 3 || report.limits.length !== 4) fail('the report does not list the three changes');
+  if (changes.length !== 6 || report.limits.length !== 7) fail('the report does not list the six changes');
+  const last = report.limits[report.limits.length - 1];
+  if (last.damping_n_s_per_m !== 30 || last.friction !== 0.3 || last.speed_limiting !== 'penalty') {
+    fail(`the limits in force at the end: ${JSON.stringify(last)}`);
+  }
 
   // The replay: the same job, cycle for cycle, with the recorded commands given back.
   const replay = spawnSync(simPath, ['--replay', journalPath, '--report', path.join(workDir, 'replay.json')],
@@ -255,7 +271,7 @@ async function setParameter(page, input, name, value) {
   }
   const replayed = JSON.parse(fs.readFileSync(path.join(workDir, 'replay.json'), 'utf8'));
   const replayedChanges = replayed.commands.list.filter((c) => c.parameter);
-  if (replayedChanges.length !== 3) fail(`the replay's report lists ${replayedChanges.length} changes`);
+  if (replayedChanges.length !== 6) fail(`the replay's report lists ${replayedChanges.length} changes`);
   console.log('PASS');
 })().catch((error) => {
   console.error(error.message || error);

@@ -93,9 +93,11 @@ function showState(message) {
     : (safe.reset_requests > 0 ? `last reset: ${safe.last_reset}` : '');
   const p = message.params;
   $('in-force').textContent = `in force: coupling ${fixed(p.coupling, 2)} N/mm, force limit ${fixed(p.force_limit, 2)} N, ` +
-    `speed limit ${p.speed_limit === null ? 'unlimited' : fixed(p.speed_limit, 2) + ' mm/s'}` +
+    `speed limit ${p.speed_limit === null ? 'unlimited' : fixed(p.speed_limit, 2) + ' mm/s'} (${p.speed_limiting}), ` +
+    `damping ${fixed(p.damping, 1)} N s/m, friction ${fixed(p.friction, 2)}` +
     (p.requests > 0 ? ` (last change ${p.last}: ${p.last_outcome})` : '');
-  for (const [id, key] of [['coupling', 'coupling'], ['force-limit', 'force_limit'], ['speed-limit', 'speed_limit']]) {
+  for (const [id, key] of [['coupling', 'coupling'], ['force-limit', 'force_limit'], ['speed-limit', 'speed_limit'],
+    ['damping', 'damping'], ['friction', 'friction'], ['speed-limiting', 'speed_limiting']]) {
     const input = $(id);
     if (document.activeElement !== input && input.dataset.edited !== '1' && p[key] !== null) {
       input.value = p[key];
@@ -185,12 +187,14 @@ const link = connect(`/ws${token ? `?token=${encodeURIComponent(token)}` : ''}`,
 
 for (const button of document.querySelectorAll('#params button')) {
   button.addEventListener('click', () => {
-    const input = button.parentElement.querySelector('input');
+    const input = button.parentElement.querySelector('input, select');
     input.dataset.edited = '';
-    link.send({ type: 'set', name: button.dataset.name, value: Number(input.value) });
+    // A select (the speed limiting) sends its value's name, an input its number.
+    const value = input.tagName === 'SELECT' ? input.value : Number(input.value);
+    link.send({ type: 'set', name: button.dataset.name, value });
   });
 }
-for (const input of document.querySelectorAll('#params input')) {
+for (const input of document.querySelectorAll('#params input, #params select')) {
   input.addEventListener('input', () => { input.dataset.edited = '1'; });
 }
 $('reset').addEventListener('click', () => link.send({ type: 'reset' }));

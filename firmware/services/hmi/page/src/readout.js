@@ -27,8 +27,11 @@ function describe(event) {
   }
   let what = event.type;
   if (event.parameter) {
-    const applied = event.applied === null ? 'unlimited' : Number(event.applied).toPrecision(4);
-    const asked = event.asked === null ? 'unlimited' : Number(event.asked).toPrecision(4);
+    // The speed limiting is a choice, 0 or 1 on the wire: said by its name.
+    const value = (v) => (v === null ? 'unlimited'
+      : event.parameter === 'speed_limiting' ? ({ 0: 'cap', 1: 'penalty' }[v] ?? String(v)) : Number(v).toPrecision(4));
+    const applied = value(event.applied);
+    const asked = value(event.asked);
     what = `${event.parameter} asked ${asked}, in force ${applied}`;
   }
   const ok = event.outcome === 'done';
