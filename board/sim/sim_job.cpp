@@ -203,6 +203,14 @@ SimResult run_on(const SimJob& job, const runtime::PeriodicRunner* runner, SimMa
   }
   result.started = true;
   result.rss_after_setup_kb = resident_kb();
+  if (job.replay == nullptr) {
+    for (const control::Command& command : job.opening_commands) {
+      if (!assembled.rings().commands.push(command)) {
+        result.error = "the opening commands do not fit the command ring";
+        return result;
+      }
+    }
+  }
   mill.arm();
   if (realtime) {
     return run_threads(job, assembled, mill, hand, *runner, result, wall_start);

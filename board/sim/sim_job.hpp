@@ -28,6 +28,7 @@
 #include "hal/clock.hpp"
 #include "hal/linuxcnc/linuxcnc_link.hpp"
 #include "sim/mill/stock_zmap.hpp"
+#include "sim/operator/hand_device_model.hpp"
 #include "sim/operator/operator_script.hpp"
 
 namespace stencil::board::sim {
@@ -79,6 +80,12 @@ struct SimJob {
   // (sim/linuxcnc_mill runs one): the link's configuration, and the file halsampler writes every servo
   // period's joint positions to, the ground truth of what was machined.
   std::optional<LinuxcncMill> linuxcnc;
+  // The operator's hand: kNoHand is today's placed hand (operator_script.hpp's OperatorHand); a preset
+  // is the arm of hand_device_model.hpp pulling the handle, which has its own mass and friction.
+  stencil::sim::HandParameters hand = stencil::sim::kNoHand;
+  // The operator's commands before the first cycle (the wall's feel from the start): journalled and
+  // taken like a display's. Not given to a replay, which has them from its journal.
+  std::vector<control::Command> opening_commands;
 };
 
 using report::Quantiles;

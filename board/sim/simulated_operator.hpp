@@ -3,6 +3,7 @@
 // millisecond (a hook of the job's run).
 #pragma once
 
+#include <optional>
 #include <string>
 
 #include "board/sim/device_process.hpp"
@@ -10,6 +11,7 @@
 #include "board/sim/simulated_device_wiring.hpp"
 #include "firmware/runtime/job_hooks.hpp"
 #include "hal/haptic_device.hpp"
+#include "sim/operator/hand_device_model.hpp"
 #include "sim/operator/operator_script.hpp"
 
 namespace stencil::board::sim {
@@ -35,10 +37,15 @@ class SimulatedOperator final : public runtime::JobHooks {
   bool before_cycle(const runtime::CycleTime& time) override;
 
  private:
+  void move_dynamic_hand(const runtime::CycleTime& time, double script_s);
+
   const SimJob& job_;
   double duration_s_;  // the script's, or the job's
   bool lockstep_;
   stencil::sim::OperatorHand hand_;  // before the wiring: its device samples the handle
+  // With a dynamic hand (SimJob::hand), the arm and the handle's dynamics, from the first cycle: the
+  // script is where the hand means to go, and hand_ only carries the handle's position to the device.
+  std::optional<stencil::sim::HandDeviceModel> dynamics_;
   std::string wiring_error_;
   SimulatedDeviceWiring wiring_;
   DeviceProcess process_;

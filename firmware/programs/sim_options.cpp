@@ -98,6 +98,28 @@ void add_record_options(CLI::App& app, SimOptions& o) {
                  "SocketCAN code over a memfd or a socketpair")
       ->check(CLI::IsMember({"direct", "pio", "can"}))
       ->capture_default_str();
+  app.add_option("--hand", o.hand,
+                 "the operator's hand on the handle: placed (it puts the handle where its script and the force "
+                 "say, today's), or an arm that pulls the handle as a mass-spring-damper with the device's own mass "
+                 "and friction, integrated at 20 kHz: relaxed (0.1 kg, 50 N/m, 1 N s/m), medium (0.3 kg, 300 N/m, "
+                 "5 N s/m) or stiff (0.5 kg, 1000 N/m, 15 N s/m)")
+      ->check(CLI::IsMember({"placed", "relaxed", "medium", "stiff"}))
+      ->capture_default_str();
+  app.add_option("--damping", o.damping_n_s_per_m,
+                 "N s/m of virtual damping in the wall from the first cycle, with the passivity controller (0: none; "
+                 "the cycle takes at most 100), as the operator's command set_damping: journalled and replayed")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  app.add_option("--friction", o.friction,
+                 "the Coulomb friction coefficient of the virtual tool on the part from the first cycle (0 to 1), as "
+                 "the operator's command set_friction")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--speed-limiting", o.speed_limiting,
+                 "cap: the virtual tool's speed capped at the mill's; penalty: that, and damping on the hand that "
+                 "rises as it nears that speed, as the operator's command set_speed_limiting from the first cycle")
+      ->check(CLI::IsMember({"cap", "penalty"}))
+      ->capture_default_str();
 }
 
 // --inject KIND@SECONDS, on the virtual clock only.
@@ -197,6 +219,8 @@ bool check_sim_options(const CLI::App& app, SimOptions& o, std::string& error) {
     error = "--gcode writes the program from the job's journal: not with --no-journal, --replay or --commission";
   } else if (!o.device_log_path.empty() && (o.transport != "pio" || !o.inject_text.empty())) {
     error = "--device-process: the device runs in its own process only with --haptic-transport pio and no --inject";
+  } else if (!o.device_log_path.empty() && o.hand != "placed") {
+    error = "--device-process: the device's own process moves the placed hand only (no --hand " + o.hand + ")";
   } else if (o.fast == (o.speed > 0.0)) {
     error = o.fast ? "--fast and --speed: choose one" : "pass --fast (virtual time) or --speed N (N x real time)";
   }

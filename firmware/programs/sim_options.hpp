@@ -57,6 +57,13 @@ struct SimOptions {
   std::string trace_path;
   std::string script_csv_path;
   std::string transport = "direct";
+  // The operator's hand (issue 29): "placed", today's quasi-static hand that places the handle, or a
+  // dynamic arm (sim/operator/hand_device_model.hpp) pulling it: relaxed, medium or stiff.
+  std::string hand = "placed";
+  // The wall's feel from the first cycle, as the operator's commands (journalled, replayed).
+  double damping_n_s_per_m = 0.0;
+  double friction = 0.0;
+  std::string speed_limiting = "cap";
   DisplayOptions display;
 
   [[nodiscard]] bool real_time() const { return !fast && speed == 1.0; }

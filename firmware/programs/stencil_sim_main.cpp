@@ -291,6 +291,24 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
     std::snprintf(files, sizeof files, " config-crc32=%08x mill-truth-crc32=%08x", o.config_crc32, o.mill_truth_crc32);
   }
   job_text += files;
+  // A dynamic hand is another operator (the placed hand's text is as before).
+  for (const sim::HandParameters& hand : sim::kHandPresets) {
+    if (o.hand == hand.name) {
+      job.hand = hand;
+      job_text += " hand=" + o.hand;
+    }
+  }
+  // The wall's feel as the operator's commands before the first cycle; none given, none sent.
+  constexpr auto kProgram = control::CommandSource::Program;
+  if (o.damping_n_s_per_m > 0.0) {
+    job.opening_commands.push_back({control::CommandKind::SetDamping, o.damping_n_s_per_m, kProgram});
+  }
+  if (o.friction > 0.0) {
+    job.opening_commands.push_back({control::CommandKind::SetFriction, o.friction, kProgram});
+  }
+  if (o.speed_limiting == "penalty") {
+    job.opening_commands.push_back({control::CommandKind::SetSpeedLimiting, 1.0, kProgram});
+  }
   if (job_text.size() > 1024) {
     error = "--tables and --operator: paths too long to record in the journal (" + std::to_string(job_text.size()) +
             " bytes of the job; at most 1024)";

@@ -35,7 +35,10 @@ run() {
   echo "  exit status $status"
 }
 
-run_sim() { run "$sim" "$@"; }
+# STENCIL_SIM_FEEL: options every stencil-sim run here also gets (make feel-check runs the job cases
+# and the fault suite with the wall's feel and a dynamic hand this way); empty in CI.
+read -r -a sim_feel <<<"${STENCIL_SIM_FEEL:-}"
+run_sim() { run "$sim" "$@" "${sim_feel[@]}"; }
 run_rig() { run "$rig" "$@"; }
 
 expect_status() {
@@ -199,6 +202,24 @@ case_plunge() {
   run_sim --fast --pattern plunge --duration 150 --report report.json
   expect_status 0
   no_gouge
+}
+
+# Issue 29: the wall's feel on (damping, friction, the penalty speed limiting) with a dynamic hand
+# pulling the handle: the engine still decides every move, so no gouge; the report lists the three
+# opening commands, applied at the first cycle, and the limits they set.
+case_plunge_with_the_walls_feel_and_a_dynamic_hand() {
+  run_sim --fast --pattern plunge --duration 150 --hand medium --damping 30 --friction 0.5 --speed-limiting penalty \
+    --report report.json
+  expect_status 0
+  no_gouge
+  python3 - report.json <<'PY' || fail "the report does not show the wall's feel in force"
+import json, sys
+r = json.load(open(sys.argv[1]))
+sets = [(c["parameter"], c["applied"], c["source"], c["cycle"]) for c in r["commands"]["list"] if c.get("parameter")]
+assert sets == [("damping", 30.0, "program", 1), ("friction", 0.5, "program", 1), ("speed_limiting", 1.0, "program", 1)], sets
+last = r["limits"][-1]
+assert (last["damping_n_s_per_m"], last["friction"], last["speed_limiting"]) == (30.0, 0.5, "penalty"), last
+PY
 }
 
 case_thinwall() {

@@ -128,6 +128,27 @@ TEST(SimOptions, TheDeviceProcessNeedsPioAndNoInject) {
   CHECK_TRUE(Checked({"--fast", "--device-process", "d.log", "--haptic-transport", "pio"}).ok);
 }
 
+// Issue 29: the hand and the wall's feel; by default today's placed hand and no feel at all.
+TEST(SimOptions, TheHandAndTheWallsFeelDefaultToTodaysAndAreChecked) {
+  const Checked plain({"--fast"});
+  STRCMP_EQUAL("placed", plain.options.hand.c_str());
+  DOUBLES_EQUAL(0.0, plain.options.damping_n_s_per_m, 0.0);
+  DOUBLES_EQUAL(0.0, plain.options.friction, 0.0);
+  STRCMP_EQUAL("cap", plain.options.speed_limiting.c_str());
+  const Checked felt({"--fast", "--hand", "stiff", "--damping", "40", "--friction", "0.5", "--speed-limiting", "penalty"});
+  CHECK_TRUE(felt.ok);
+  STRCMP_EQUAL("stiff", felt.options.hand.c_str());
+  DOUBLES_EQUAL(40.0, felt.options.damping_n_s_per_m, 0.0);
+  DOUBLES_EQUAL(0.5, felt.options.friction, 0.0);
+  STRCMP_EQUAL("penalty", felt.options.speed_limiting.c_str());
+  CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--hand", "firm"}));
+  CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--friction", "1.5"}));
+  CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--damping", "-1"}));
+  CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--speed-limiting", "brake"}));
+  STRCMP_EQUAL("--device-process: the device's own process moves the placed hand only (no --hand medium)",
+               Checked({"--fast", "--device-process", "d.log", "--haptic-transport", "pio", "--hand", "medium"}).error.c_str());
+}
+
 TEST(SimOptions, CliRefusesAnUnknownPatternOrTransport) {
   CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--pattern", "zigzag"}));
   CHECK_THROWS(CLI::ValidationError, Checked({"--fast", "--haptic-transport", "usb"}));

@@ -83,3 +83,37 @@ TEST(SimulatedOperator, TheForceOffIsTheDevicesInProcess) {
   static_cast<void>(simulated.device().write_command({{1.0, 0.0, 0.0}, {0.0, 0.0}, 1, true}));
   CHECK_FALSE(simulated.force_off());
 }
+
+// Issue 29: a dynamic hand pulls the handle as a mass on a spring towards the script. With no force
+// rendered, the medium hand (0.3 kg + the device's 0.2 kg on 300 N/m, 5 N s/m) starting at rest
+// while the script runs at 10 mm/s lags behind it and catches up: it neither jumps to the script
+// nor keeps today's placed hand's fixed fraction.
+TEST(SimulatedOperator, ADynamicHandLagsTheScriptAsAMassOnASpringAndCatchesUp) {
+  SimJob job = straight_job();
+  job.hand = stencil::sim::kMediumHand;
+  SimulatedOperator simulated(job, true);
+  STRCMP_EQUAL("", simulated.start().c_str());
+  DOUBLES_EQUAL(200.0, x_after(simulated, 0.0), 1e-9);
+  double x = 200.0;
+  for (int ms = 1; ms <= 10; ++ms) {
+    x = x_after(simulated, 0.001 * ms);
+  }
+  // 10 ms in the script is at 200.1: the handle has barely started (it accelerates from rest).
+  CHECK(x > 200.0 && x < 200.05);
+  for (int ms = 11; ms <= 3000; ++ms) {
+    x = x_after(simulated, 0.001 * ms);
+  }
+  // After 3 s (about 11 of its periods of 0.26 s, damped) it follows the script at 230 closely,
+  // behind it by the Coulomb friction's 0.05 N over 300 N/m and the damping's lag at most.
+  DOUBLES_EQUAL(230.0, x, 0.3);
+  CHECK(x < 230.0);
+}
+
+TEST(SimulatedOperator, TheDeviceProcessMovesOnlyThePlacedHand) {
+  SimJob job = straight_job();
+  job.transport = HapticTransport::Pio;
+  job.hand = stencil::sim::kStiffHand;
+  job.device_process_log = stderr;  // asked for; never started here
+  SimulatedOperator simulated(job, true);
+  STRCMP_EQUAL("the device's own process moves the placed hand only, not a dynamic one", simulated.start().c_str());
+}
