@@ -11,6 +11,10 @@
 
 #include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/haptic_force.hpp"
+#include "firmware/core/stencil/passivity_controller.hpp"
+#include "firmware/core/stencil/surface_friction.hpp"
+#include "firmware/core/stencil/velocity_filter.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
 #include "tests/bench/fcl_reference.hpp"
@@ -146,12 +150,14 @@ int main(int argc, char** argv) {
           "--state free|light|deep|deep-corner: only that state (for profiling one case).\n"
           "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
           "timed the same way, so the machine's own tail can be told from the code's.\n"
+          "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity), on\n"
+          "its longest path (the probe under a resting tool and the query at the friction's goal).\n"
           "--json: one JSON object per line.\n");
       return argument == "--help" || argument == "-h" ? 0 : 2;
     }
   }
   if (!json) {
-    std::printf("%9s %-12s %-10s %-5s %10s %10s %10s %8s\n", "points", "state", "impl", "what", "median_us",
+    std::printf("%9s %-12s %-12s %-5s %10s %10s %10s %8s\n", "points", "state", "impl", "what", "median_us",
                 "p999_us", "max_us", "samples");
   }
   const double radius = 1.5;
@@ -195,7 +201,7 @@ int main(int argc, char** argv) {
             part.point_count(), part.triangle_count(), state.name, impl, what, t.median_us, t.p999_us, t.max_us,
             t.samples);
       } else {
-        std::printf("%9u %-12s %-10s %-5s %10.2f %10.2f %10.2f %8zu\n", part.point_count(), state.name, impl, what,
+        std::printf("%9u %-12s %-12s %-5s %10.2f %10.2f %10.2f %8zu\n", part.point_count(), state.name, impl, what,
                     t.median_us, t.p999_us, t.max_us, t.samples);
       }
       std::fflush(stdout);
@@ -219,6 +225,47 @@ int main(int argc, char** argv) {
           5000, 2.0);
       report_row(state, "stencil", "cycle", cycle);
       report_row(state, "baseline", "cycle", baseline_of_length(cycle.median_us));
+      // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
+      // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
+      // the part slides), the probe under the resting tool and the query at the friction's goal, then
+      // the velocity filters, the damper and the passivity observer and controller, and the force.
+      const Timing felt = measure(
+          [&] {
+            engine::VirtualTool tool(part, state.resting);
+            const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
+            const engine::FrictionGoal goal = engine::friction_goal(tool.tip_mm(), state.desired, contact, 10.0, 0.05);
+            engine::RemediationResult result{};
+            bool moved = false;
+            if (goal.in_contact && contact.force_n.norm() > 0.0) {
+              const engine::ContactResult below =
+                  tool.contact_at(tool.tip_mm() - 0.01 * contact.force_n.normalized(), parameters);
+              if (below.penetrating_points > 0 && !goal.sticking) {
+                result = tool.step(goal.goal_mm, tool.contact_at(goal.goal_mm, parameters), parameters);
+                moved = true;
+              }
+            }
+            if (!moved) {
+              result = tool.step(state.desired, contact, parameters);
+            }
+            engine::VelocityFilter stretch_rate, handle_velocity;
+            stretch_rate.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
+            handle_velocity.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
+            engine::PassivityController passivity;
+            const Eigen::Vector3d stretch = 1e-2 * (result.tip_mm - state.desired);
+            static_cast<void>(stretch_rate.update(stretch));
+            static_cast<void>(handle_velocity.update(1e-2 * state.desired));
+            static_cast<void>(passivity.observe(contact.force_n, 1e-5 * Eigen::Vector3d::Ones()));
+            const Eigen::Vector3d added =
+                30.0 * stretch_rate.update(stretch + Eigen::Vector3d::Constant(1e-6)) +
+                passivity.correction(handle_velocity.update(1e-2 * state.desired + Eigen::Vector3d::Constant(1e-5)),
+                                     1e-3, 5.0);
+            const engine::HapticOutput out =
+                engine::haptic_output(state.desired, result.tip_mm, contact, engine::HapticLimits{}, added);
+            sink = sink + contact.max_depth_mm + result.tip_mm.z() + out.force_n.x();
+          },
+          5000, 2.0);
+      report_row(state, "stencil+feel", "cycle", felt);
+      report_row(state, "baseline", "cycle", baseline_of_length(felt.median_us));
       if (!references) {
         continue;
       }
