@@ -1,5 +1,5 @@
 # Short names for the README's commands. Every target installs what it needs first (idempotent).
-.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan same-behaviour mutation-check fresh-check package package-check clean help
+.PHONY: all deps build test e2e test-asan test-debug rt fuzz bench demo latency soak stall-seeds soak-asan feel-check wall-test same-behaviour mutation-check fresh-check package package-check clean help
 
 all: build
 
@@ -16,6 +16,8 @@ help:
 	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
 	@echo "make stall-seeds the random operator for STALL_HOURS (2) on seeds 1..STALL_SEEDS (20): no stall, no gouge (build/stall-seeds)"
 	@echo "make soak-asan  a half-hour slice of it under ASan + UBSan, for leaks (build/soak-asan)"
+	@echo "make wall-test  the wall's feel: taps and slides for every hand and coupling, today's rendering beside the new (stencil-wall-test)"
+	@echo "make feel-check the demo's job and the e2e job and fault cases again with the wall's feel on and a dynamic hand (FEEL=...; about 15 minutes)"
 	@echo "make size-check clang-tidy's function sizes: main() of a program <= 150 lines, runtime, boards and programs' other functions <= 80 (in CI)"
 	@echo "make same-behaviour OLD=<commit>  a refactor's proof: OLD's and this tree's deterministic jobs give the same reports and journals"
 	@echo "make mutation-check each behaviour in tests/mutations.tsv broken by a one-line change: its test must fail (build/mutation; about 15 minutes)"
@@ -86,6 +88,22 @@ soak-asan: deps
 	cmake --preset asan
 	cmake --build --preset asan --target stencil-sim
 	bash toolchain/soak.sh build/asan/bin/stencil-sim build/soak-asan 0.5 4 $(SOAK_SEED)
+
+# The wall's feel (issue 29): the whole table, taps at three speeds and the slides.
+wall-test: build
+	build/bin/stencil-wall-test --tap-speed 200
+	build/bin/stencil-wall-test --tap-speed 1000
+	build/bin/stencil-wall-test --tap-speed 2000 --test tap
+	build/bin/stencil-wall-test --test speed
+
+# A measurement, not a test: with the wall's feel on and a dynamic hand, the demo's job and the e2e
+# job and fault cases must keep their gouge figures (at most 0.005 mm; tests/e2e/sim_cli.sh with
+# STENCIL_SIM_FEEL).
+FEEL ?= --hand medium --damping 30 --friction 0.5 --speed-limiting penalty
+feel-check: build
+	build/bin/stencil-sim --fast --pattern raster --until-complete --out-dir build/feel-check --keep-jobs 3 $(FEEL)
+	STENCIL_SIM_FEEL="$(FEEL)" ctest --test-dir build -j2 --output-on-failure \
+	  -R '^e2e\.sim_(raster_corner|plunge|thinwall|random|reference_job|fault_.*)$$'
 
 # A check .ci/run makes after make test: clang-tidy's readability-function-size over the programs
 # (main() at most 150 lines) and the runtime, boards and programs' other files (80 lines a function), with the release configuration's compile_commands.json (toolchain/size-check.sh).
