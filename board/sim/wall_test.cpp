@@ -271,6 +271,60 @@ bool ramp_pull(WallBench& bench, const Eigen::Vector3d& from, double pull_n) {
   return false;
 }
 
+// Dragged along the face (device +x) from `pressed`: the friction felt while the tool slides, in
+// row.friction_ratio. False with row.error when it never slid or the cycle stopped.
+bool drag_along_face(WallBench& bench, const WallCase& c, const Eigen::Vector3d& pressed, WallRow& row) {
+  // Dragged along the face (device +x): the tool first sticks while the hand and the coupling stretch
+  // (at 0.05 N per device mm and the relaxed hand, about 40 device mm of the hand's way), then slides.
+  // The friction is measured over 0.6 s of sliding, from 0.4 s after it began, on the periods in
+  // which the tool slid along the face.
+  bench.model().set_intent(pressed, Eigen::Vector3d(std::min(c.speed_device_mm_per_s, 50.0), 0.0, 0.0));
+  const auto slid = [&bench] {
+    const std::vector<Sample>& s = bench.samples();
+    const Eigen::Vector3d moved = s.back().tip_mm - s[s.size() - 2].tip_mm;
+    return std::hypot(moved.x(), moved.y()) > 1e-7;
+  };
+  bool sliding = false;
+  for (int period = 0; period < kMaxStickPeriods && !sliding; ++period) {
+    if (!bench.step()) {
+      row.error = safe_state_error(bench, "while dragged");
+      return false;
+    }
+    sliding = slid();
+  }
+  if (!sliding) {
+    row.error = "the tool never slid along the face while dragged";
+    return false;
+  }
+  if (!bench.run_for(0.4)) {
+    row.error = safe_state_error(bench, "while sliding");
+    return false;
+  }
+  const std::size_t measured_from = bench.samples().size();
+  if (!bench.run_for(0.6)) {
+    row.error = safe_state_error(bench, "while sliding");
+    return false;
+  }
+  // The force the hand felt: what the motors drove (after the link's delay), not the command.
+  double tangential = 0.0, normal = 0.0;
+  int slipping = 0;
+  const std::vector<Sample>& s = bench.samples();
+  for (std::size_t i = measured_from; i < s.size(); ++i) {
+    const Eigen::Vector3d moved = s[i].tip_mm - s[i - 1].tip_mm;
+    if (std::hypot(moved.x(), moved.y()) > 1e-7) {
+      tangential -= s[i].applied_n.x();  // along the drag (+x), signed: the contact's sideways waver cancels
+      normal += s[i].applied_n.z();
+      ++slipping;
+    }
+  }
+  if (slipping == 0 || !(normal > 0.0)) {
+    row.error = "the tool never slid along the face while dragged";
+    return false;
+  }
+  row.friction_ratio = tangential / normal;
+  return true;
+}
+
 void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start, double wall_z, double push_depth_mm,
                WallRow& row) {
   // Pressed onto the face at 100 device mm/s and held: its figures as a slow tap's. From 50 device mm
@@ -299,54 +353,9 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
   if (!row.error.empty()) {
     return;
   }
-  // Dragged along the face (device +x): the tool first sticks while the hand and the coupling stretch
-  // (at 0.05 N per device mm and the relaxed hand, about 40 device mm of the hand's way), then slides.
-  // The friction is measured over 0.6 s of sliding, from 0.4 s after it began, on the periods in
-  // which the tool slid along the face.
-  bench.model().set_intent(pressed, Eigen::Vector3d(std::min(c.speed_device_mm_per_s, 50.0), 0.0, 0.0));
-  const auto slid = [&bench] {
-    const std::vector<Sample>& s = bench.samples();
-    const Eigen::Vector3d moved = s.back().tip_mm - s[s.size() - 2].tip_mm;
-    return std::hypot(moved.x(), moved.y()) > 1e-7;
-  };
-  bool sliding = false;
-  for (int period = 0; period < kMaxStickPeriods && !sliding; ++period) {
-    if (!bench.step()) {
-      row.error = safe_state_error(bench, "while dragged");
-      return;
-    }
-    sliding = slid();
-  }
-  if (!sliding) {
-    row.error = "the tool never slid along the face while dragged";
+  if (!drag_along_face(bench, c, pressed, row)) {
     return;
   }
-  if (!bench.run_for(0.4)) {
-    row.error = safe_state_error(bench, "while sliding");
-    return;
-  }
-  const std::size_t measured_from = bench.samples().size();
-  if (!bench.run_for(0.6)) {
-    row.error = safe_state_error(bench, "while sliding");
-    return;
-  }
-  // The force the hand felt: what the motors drove (after the link's delay), not the command.
-  double tangential = 0.0, normal = 0.0;
-  int slipping = 0;
-  const std::vector<Sample>& s = bench.samples();
-  for (std::size_t i = measured_from; i < s.size(); ++i) {
-    const Eigen::Vector3d moved = s[i].tip_mm - s[i - 1].tip_mm;
-    if (std::hypot(moved.x(), moved.y()) > 1e-7) {
-      tangential -= s[i].applied_n.x();  // along the drag (+x), signed: the contact's sideways waver cancels
-      normal += s[i].applied_n.z();
-      ++slipping;
-    }
-  }
-  if (slipping == 0 || !(normal > 0.0)) {
-    row.error = "the tool never slid along the face while dragged";
-    return;
-  }
-  row.friction_ratio = tangential / normal;
   // Held inside the cone: the hand stops right over the tool (no pull left along the face), then
   // pulls along it, slowly, until the pull is half what the cone holds; the tool must not move.
   const double over_tool_x = motion::world_to_device(bench.frames(), bench.samples().back().tip_mm).x();
