@@ -380,22 +380,28 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
   }
 }
 
-// The hand as it pushes on faster than the mill follows: its intent runs along +x at the case's speed
-// from `start`, but never more than push / k (its arm's stiffness) ahead of the handle, so the arm's
-// spring pulls with at most the push; held back, the intent rides along with the handle at its speed
-// over the period, leaving the arm's damper nothing to add. A force source of at most the push, then:
-// what the penalty must hold on its own (a real arm's damping would only help it).
-void push_along(WallBench& bench, const Eigen::Vector3d& start, double scripted_s, double speed, double lead_mm,
-                bool& pushing) {
-  const double scripted_x = start.x() + speed * scripted_s;
-  const Eigen::Vector3d handle = bench.model().position_mm();
-  if (scripted_x <= handle.x() + lead_mm) {
-    bench.model().set_intent({scripted_x, start.y(), start.z()}, {speed, 0.0, 0.0});
+// A unit vector in the horizontal plane, `degrees` from +x towards +y.
+Eigen::Vector3d heading_of(double degrees) {
+  const double radians = degrees * 3.14159265358979323846 / 180.0;
+  return {std::cos(radians), std::sin(radians), 0.0};
+}
+
+// The hand as it pushes on faster than the mill follows: its intent runs along `way` (a unit vector)
+// at the case's speed from `start`, but never more than push / k (its arm's stiffness) ahead of the
+// handle along it, so the arm's spring pulls with at most the push; held back, the intent rides along
+// with the handle at its speed over the period, leaving the arm's damper nothing to add. A force
+// source of at most the push, then: what the penalty must hold on its own (a real arm's damping would
+// only help it).
+void push_along(WallBench& bench, const Eigen::Vector3d& start, const Eigen::Vector3d& way, double scripted_s,
+                double speed, double lead_mm, bool& pushing) {
+  const double scripted = speed * scripted_s;
+  const double handle = (bench.model().position_mm() - start).dot(way);
+  if (scripted <= handle + lead_mm) {
+    bench.model().set_intent(start + scripted * way, speed * way);
     return;
   }
   pushing = true;
-  bench.model().set_intent({handle.x() + lead_mm, start.y(), start.z()},
-                           {bench.model().velocity_mm_per_s().x(), 0.0, 0.0});
+  bench.model().set_intent(start + (handle + lead_mm) * way, bench.model().velocity_mm_per_s().dot(way) * way);
 }
 
 // Where the speed first peaked (an index into `speed`), on the speed averaged over
@@ -430,12 +436,14 @@ std::size_t first_speed_peak(const std::vector<double>& speed, double steady, do
   return peak;
 }
 
-// The speed's figures from the samples [from, end): the handle's speed along +x a period at a time.
-void speed_figures(const std::vector<Sample>& s, std::size_t from, const motion::MachineFrames& frames, WallRow& row) {
+// The speed's figures from the samples [from, end): the handle's speed along `way` (a unit vector) a
+// period at a time.
+void speed_figures(const std::vector<Sample>& s, std::size_t from, const motion::MachineFrames& frames,
+                   const Eigen::Vector3d& way, WallRow& row) {
   std::vector<double> t, speed;
   for (std::size_t i = from + 1; i < s.size(); ++i) {
     t.push_back(s[i].t_s);
-    speed.push_back((s[i].handle_mm.x() - s[i - 1].handle_mm.x()) / (s[i].t_s - s[i - 1].t_s));
+    speed.push_back((s[i].handle_mm - s[i - 1].handle_mm).dot(way) / (s[i].t_s - s[i - 1].t_s));
   }
   if (t.size() < 2) {
     row.error = "the case ran no periods";
@@ -447,7 +455,7 @@ void speed_figures(const std::vector<Sample>& s, std::size_t from, const motion:
   for (std::size_t i = 0; i < t.size(); ++i) {
     if (t[i] > t.back() - kSteadyWindowS) {
       sum += speed[i];
-      lag += s[from + 1 + i].handle_mm.x() - motion::world_to_device(frames, s[from + 1 + i].tip_mm).x();
+      lag += (s[from + 1 + i].handle_mm - motion::world_to_device(frames, s[from + 1 + i].tip_mm)).dot(way);
       row.steady_max_device_mm_per_s = std::max(row.steady_max_device_mm_per_s, speed[i]);
       ++n;
     }
@@ -498,9 +506,10 @@ control::ControllerConfig speed_config(const tables::PartTables& part, const Wal
 WallRow run_speed_case(const tables::PartTables& part, const WallCase& c) {
   WallRow row;
   row.c = c;
-  row.limit_device_mm_per_s = mill_speed_device_mm_per_s();
   Eigen::Vector3d start;
   const control::ControllerConfig config = speed_config(part, c, start);
+  const Eigen::Vector3d way = heading_of(c.heading_deg);
+  row.limit_device_mm_per_s = mill_speed_device_mm_per_s(way);
   if (!(c.hand.stiffness_n_per_m > 0.0) || !(c.push_n > 0.0)) {
     row.error = "the hand has no stiffness or no push: it cannot push";
     return row;
@@ -522,7 +531,7 @@ WallRow run_speed_case(const tables::PartTables& part, const WallCase& c) {
   bool pushing = false;
   double pushing_since_s = std::numeric_limits<double>::infinity();
   while (bench.now_s() - began_s < kMaxSpeedCaseS && bench.now_s() < pushing_since_s + kSpeedSettleS) {
-    push_along(bench, start, bench.now_s() - began_s, c.speed_device_mm_per_s, lead_mm, pushing);
+    push_along(bench, start, way, bench.now_s() - began_s, c.speed_device_mm_per_s, lead_mm, pushing);
     if (pushing && !std::isfinite(pushing_since_s)) {
       pushing_since_s = bench.now_s();
     }
@@ -531,7 +540,7 @@ WallRow run_speed_case(const tables::PartTables& part, const WallCase& c) {
       return row;
     }
   }
-  speed_figures(bench.samples(), from, bench.frames(), row);
+  speed_figures(bench.samples(), from, bench.frames(), way, row);
   return row;
 }
 
@@ -543,10 +552,11 @@ WallRow run_release_case(const tables::PartTables& part, const WallCase& c) {
   WallRow row;
   row.c = c;
   row.c.hand = stencil::sim::kNoHand;
-  row.limit_device_mm_per_s = mill_speed_device_mm_per_s();
+  row.limit_device_mm_per_s = mill_speed_device_mm_per_s(Eigen::Vector3d::UnitX());
   Eigen::Vector3d start;
   control::ControllerConfig config = speed_config(part, c, start);
-  config.home_tip_mm.x() += config.haptic.max_force_n / c.coupling_n_per_device_mm / config.frames.device_mm_per_world_mm;
+  const double stretch_device_mm = config.haptic.max_force_n / c.coupling_n_per_device_mm;
+  config.home_tip_mm.x() += stretch_device_mm / config.frames.device_mm_per_world_mm;
   config.ramp_time_s = 0.0;
   WallBench bench(part, row.c, config, start);
   if (!bench.ready()) {
@@ -557,7 +567,7 @@ WallRow run_release_case(const tables::PartTables& part, const WallCase& c) {
     row.error = safe_state_error(bench, "while the handle was let go");
     return row;
   }
-  speed_figures(bench.samples(), 0, bench.frames(), row);
+  speed_figures(bench.samples(), 0, bench.frames(), Eigen::Vector3d::UnitX(), row);
   return row;
 }
 
@@ -578,19 +588,21 @@ const char* name_of(WallTestKind test) {
   return "tap";
 }
 
-double mill_speed_device_mm_per_s() {
+double mill_speed_device_mm_per_s(const Eigen::Vector3d& way) {
   const control::ControllerConfig config = controller_config(false);
-  return config.max_axis_move_mm / config.period_s * config.haptic.device_mm_per_world_mm;
+  const double per_period = config.haptic.device_mm_per_world_mm / config.period_s;
+  return engine::mill_speed_along(way, per_period * config.max_axis_move_mm, per_period * config.max_total_move_mm);
 }
 
 WallCase speed_test_case(const stencil::sim::HandParameters& hand, double coupling_n_per_device_mm,
-                         WallRendering rendering, double speed_factor, double push_n) {
+                         WallRendering rendering, double speed_factor, double push_n, double heading_deg) {
   WallCase c;
   c.hand = hand;
   c.coupling_n_per_device_mm = coupling_n_per_device_mm;
   c.rendering = rendering;
   c.test = WallTestKind::Speed;
-  c.speed_device_mm_per_s = speed_factor * mill_speed_device_mm_per_s();
+  c.heading_deg = heading_deg;
+  c.speed_device_mm_per_s = speed_factor * mill_speed_device_mm_per_s(heading_of(heading_deg));
   c.push_n = push_n;
   c.transport_delay_s = kCanDelayS;
   return c;
@@ -670,6 +682,7 @@ std::string speed_row_json(const WallRow& row) {
   j["test"] = name_of(row.c.test);
   if (row.c.test == WallTestKind::Speed) {  // a released handle has no hand to move or push it
     j["speed_device_mm_per_s"] = row.c.speed_device_mm_per_s;
+    j["heading_deg"] = row.c.heading_deg;
     j["push_n"] = row.c.push_n;
   }
   j["transport_delay_s"] = row.c.transport_delay_s;

@@ -5,8 +5,9 @@
 // friction within 5 % of the coefficient and no slip inside the cone; 1 not (the rows say where);
 // 2 usage. The virtual tool's speed limit is off for the taps and slides: the wall's feel, not the
 // mill's lag. --test speed is the mill's lag: in free space above the face, the speed limit on, a hand
-// pushing on at twice the mill's speed, held by the cap alone (previous) or by the cap and the speed
-// penalty (new); exit 0 when the new rendering holds every hand under the mill's speed, stably.
+// pushing on at twice the mill's speed (along +x, or --heading degrees from it), held by the cap alone
+// (previous) or by the cap and the speed penalty (new); exit 0 when the new rendering holds every
+// hand under the mill's speed, stably.
 // --test release lets go of the handle where the coupling pulls it back towards the lagging virtual
 // tool with the force limit (no hand: one row per coupling): exit 0 when the new rendering brings it
 // to rest stably.
@@ -51,6 +52,7 @@ int main(int argc, char** argv) {
   std::string which = "both";
   double speed_factor = 2.0;
   double penalty_slope = stencil::engine::kSpeedPenaltySlopeNSPerM;
+  double heading = 0.0;
   app.add_flag("--json", json, "one JSON object per case, one per line");
   app.add_option("--hand", hand_name, "relaxed, medium, stiff or all")->check(CLI::IsMember({"relaxed", "medium", "stiff", "all"}))->capture_default_str();
   app.add_option("--coupling", couplings, "the couplings to test (N per device mm), 0.05 to 2")
@@ -66,6 +68,10 @@ int main(int argc, char** argv) {
   app.add_option("--speed-factor", speed_factor,
                  "speed: the hand's intent as a multiple of the speed the mill follows (times the device's scale)")
       ->check(CLI::Range(1.0, 10.0))->capture_default_str();
+  app.add_option("--heading", heading,
+                 "speed: the hand's way in the horizontal plane, degrees from +x towards +y (45: where the mill "
+                 "follows least)")
+      ->check(CLI::Range(-360.0, 360.0))->capture_default_str();
   app.add_option("--penalty-slope", penalty_slope,
                  "speed: how steeply the new rendering's penalty rises (N s per device m), to measure another")
       ->check(CLI::Range(1.0, 5000.0))->capture_default_str();
@@ -97,7 +103,7 @@ int main(int argc, char** argv) {
     for (const double coupling : couplings) {
       if (which == "speed" || which == "release") {
         for (const WallRendering rendering : {WallRendering::Previous, WallRendering::New}) {
-          WallCase c = speed_test_case(hand, coupling, rendering, speed_factor, push_n);
+          WallCase c = speed_test_case(hand, coupling, rendering, speed_factor, push_n, heading);
           c.test = which == "speed" ? WallTestKind::Speed : WallTestKind::Release;
           c.transport_delay_s = delay_s;
           c.speed_penalty_slope_n_s_per_m = penalty_slope;

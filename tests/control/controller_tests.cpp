@@ -229,9 +229,9 @@ TEST(Controller, WithTheSpeedPenaltyAHandNearTheMillsSpeedIsHeldBackAndWithTheCa
     bench->move_device_to(kHomeDevice + Eigen::Vector3d(2.4, 0.0, 0.0), 8.0);  // 300 periods at 8 mm/s
   }
   DOUBLES_EQUAL(0.0, cap.force_written(), 1e-9);
-  // 350 N s/m past a quarter of the limit: 350 x (8 - 2.5) mm/s = 1.9 N, against the motion.
+  // 350 N s/m past a tenth of the limit: 350 x (8 - 1) mm/s = 2.45 N, against the motion.
   const hal::HapticCommand& held = penalty.device.last_command();
-  DOUBLES_EQUAL(-1.925, held.force_n[0], 0.05);
+  DOUBLES_EQUAL(-2.45, held.force_n[0], 0.05);
   DOUBLES_EQUAL(0.0, held.force_n[1], 1e-9);
   DOUBLES_EQUAL(0.0, held.force_n[2], 1e-9);
   CHECK(penalty.controller->safe_reason() == SafeReason::None);
@@ -244,7 +244,7 @@ TEST(Controller, TheSpeedPenaltyLeavesSlowMotionAloneAndTheCapStillBoundsTheTool
   penalised.feel.speed_limiting = engine::SpeedLimiting::Penalty;
   Bench bench(penalised);
   bench.cycles(600);
-  bench.move_device_to(kHomeDevice + Eigen::Vector3d(0.0, 0.4, 0.0), 2.0);  // under a quarter of 10 mm/s
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(0.0, 0.16, 0.0), 0.8);  // under a tenth of 10 mm/s
   DOUBLES_EQUAL(0.0, bench.force_written(), 1e-9);
   // A hand far faster than the mill: the penalty at the force limit, and the tool no faster than the cap.
   const Eigen::Vector3d before = bench.controller->virtual_tip_mm();

@@ -22,11 +22,11 @@ constexpr double kSlope = 350.0;
 
 TEST_GROUP(SpeedPenalty){};
 
-TEST(SpeedPenalty, NothingBelowAQuarterOfTheLimitThenTheSlopeAgainstTheMotion) {
-  CHECK(speed_penalty_n({0.002, 0.0, 0.0}, kLimit, kForceLimit, kSlope).isZero());
-  // 350 N s/m x (8 - 2.5) mm/s.
+TEST(SpeedPenalty, NothingBelowATenthOfTheLimitThenTheSlopeAgainstTheMotion) {
+  CHECK(speed_penalty_n({0.0009, 0.0, 0.0}, kLimit, kForceLimit, kSlope).isZero());
+  // 350 N s/m x (8 - 1) mm/s.
   const Eigen::Vector3d penalty = speed_penalty_n({0.008, 0.0, 0.0}, kLimit, kForceLimit, kSlope);
-  DOUBLES_EQUAL(-1.925, penalty.x(), 1e-12);
+  DOUBLES_EQUAL(-2.45, penalty.x(), 1e-12);
   DOUBLES_EQUAL(0.0, penalty.y(), 0.0);
   DOUBLES_EQUAL(0.0, penalty.z(), 0.0);
 }
@@ -34,7 +34,7 @@ TEST(SpeedPenalty, NothingBelowAQuarterOfTheLimitThenTheSlopeAgainstTheMotion) {
 TEST(SpeedPenalty, ItOpposesTheVelocityInAnyDirection) {
   const Eigen::Vector3d velocity(0.003, -0.004, 0.0);  // 5 mm/s
   const Eigen::Vector3d penalty = speed_penalty_n(velocity, kLimit, kForceLimit, kSlope);
-  DOUBLES_EQUAL(kSlope * (0.005 - 0.0025), penalty.norm(), 1e-12);
+  DOUBLES_EQUAL(kSlope * (0.005 - 0.001), penalty.norm(), 1e-12);
   DOUBLES_EQUAL(-1.0, penalty.normalized().dot(velocity.normalized()), 1e-12);
 }
 
@@ -53,11 +53,13 @@ TEST(SpeedPenalty, WhereTheSlopeCanReachTheForceLimitFromLaterOnTheOnsetMovesThe
   DOUBLES_EQUAL(kSlope * 0.004, speed_penalty_n({onset + 0.004, 0.0, 0.0}, limit, kForceLimit, kSlope).norm(), 1e-9);
 }
 
-TEST(SpeedPenalty, APushUnderWhatTheSlopeReachesIsHeldUnderTheLimit) {
-  // The speed at which the penalty balances a 2 N push is under the rig's limit.
-  const double balance = 0.25 * kLimit + 2.0 / kSlope;
-  CHECK(balance < kLimit);
-  DOUBLES_EQUAL(2.0, speed_penalty_n({balance, 0.0, 0.0}, kLimit, kForceLimit, kSlope).norm(), 1e-12);
+TEST(SpeedPenalty, ATwoNewtonPushIsHeldUnderTheLimitAlongAnAxisAndAHorizontalDiagonal) {
+  // Along (1, 1, 0) the cap's |dx| + |dy| bound lets the mill follow 1 / sqrt 2 of its speed.
+  for (const double limit : {kLimit, kLimit / std::sqrt(2.0)}) {
+    const double balance = 0.1 * limit + 2.0 / kSlope;  // where the penalty balances the push
+    CHECK(balance < limit);
+    DOUBLES_EQUAL(2.0, speed_penalty_n({balance, 0.0, 0.0}, limit, kForceLimit, kSlope).norm(), 1e-12);
+  }
 }
 
 TEST(SpeedPenalty, NoCapOrAnInputThatIsNotANumberGivesNothing) {

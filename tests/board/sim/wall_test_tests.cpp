@@ -101,6 +101,16 @@ TEST(WallTest, WithTheSpeedPenaltyAHandPushingOnAtTwiceTheMillsSpeedIsHeldUnderI
   CHECK(std::fabs(row.lag_device_mm) < 0.01);  // the virtual tool keeps up with the held hand
 }
 
+TEST(WallTest, AlongAHorizontalDiagonalWhereTheMillFollowsLeastTheHandIsHeldUnderItToo) {
+  const Prism prism;
+  const WallRow row = run_wall_case(
+      prism.part, speed_test_case(stencil::sim::kRelaxedHand, 0.5, WallRendering::New, 2.0, 2.0, 45.0));
+  STRCMP_EQUAL("", row.error.c_str());
+  DOUBLES_EQUAL(10.0 / std::sqrt(2.0), row.limit_device_mm_per_s, 1e-9);  // |dx| + |dy| at most the mill's speed
+  CHECK(row.held);
+  CHECK(row.stable);
+}
+
 TEST(WallTest, WithTheCapAloneTheHandRunsPastTheMillsSpeedDraggingTheLaggingTool) {
   const Prism prism;
   const WallRow row =
