@@ -30,6 +30,17 @@ constexpr double kPassiveEnergyJ = 1e-6;   // issue 29: at most 1 uJ put in per 
 constexpr int kMaxStickPeriods = 1500;
 constexpr double kDampingBaseNSPerM = 10.0;
 constexpr double kDampingPerStiffnessNSPerM = 21.0;  // per N per device mm
+// A speed case runs this long after the hand first pushes with all its push (a steady state, measured
+// over its last 0.5 s), and never longer than the second figure in all.
+constexpr double kSpeedSettleS = 2.0;
+constexpr double kMaxSpeedCaseS = 10.0;
+// A speed falling back from its highest by more than this fraction of its steady value has peaked:
+// measured a period at a time it jitters by one or two percent of it (the device's positions come in
+// whole micrometres, 1 mm/s a period, and the penalty's damping acts on that).
+constexpr double kPeakDropFraction = 0.05;
+constexpr std::size_t kPeakSmoothingPeriods = 10;
+constexpr double kSteadyWindowS = 0.5;     // a speed case's steady speed: its mean over the last of it
+constexpr double kReleaseS = 1.0;
 
 // The part's top face: its height and the middle of the points on it (world mm).
 struct Face {
@@ -378,10 +389,233 @@ void run_slide(WallBench& bench, const WallCase& c, const Eigen::Vector3d& start
   }
 }
 
+// A unit vector in the horizontal plane, `degrees` from +x towards +y.
+Eigen::Vector3d heading_of(double degrees) {
+  const double radians = degrees * 3.14159265358979323846 / 180.0;
+  return {std::cos(radians), std::sin(radians), 0.0};
+}
+
+// The hand as it pushes on faster than the mill follows: its intent runs along `way` (a unit vector)
+// at the case's speed from `start`, but never more than push / k (its arm's stiffness) ahead of the
+// handle along it, so the arm's spring pulls with at most the push; held back, the intent rides along
+// with the handle at its speed over the period, leaving the arm's damper nothing to add. A force
+// source of at most the push, then: what the penalty must hold on its own (a real arm's damping would
+// only help it).
+void push_along(WallBench& bench, const Eigen::Vector3d& start, const Eigen::Vector3d& way, double scripted_s,
+                double speed, double lead_mm, bool& pushing) {
+  const double scripted = speed * scripted_s;
+  const double handle = (bench.model().position_mm() - start).dot(way);
+  if (scripted <= handle + lead_mm) {
+    bench.model().set_intent(start + scripted * way, speed * way);
+    return;
+  }
+  pushing = true;
+  bench.model().set_intent(start + (handle + lead_mm) * way, bench.model().velocity_mm_per_s().dot(way) * way);
+}
+
+// Where the speed first peaked (an index into `speed`), on the speed averaged over
+// kPeakSmoothingPeriods (the penalty acts on a velocity estimated from positions in whole micrometres,
+// 1 mm/s a period, and the handle jitters with it by a few percent): once past half its steady value,
+// the highest before it first falls back by more than kPeakDropFraction of the steady value; a speed
+// that only rises to its steady value peaks where it first gets there.
+std::size_t first_speed_peak(const std::vector<double>& speed, double steady, double& peak_speed) {
+  std::vector<double> smooth(speed.size());
+  double running = 0.0;
+  for (std::size_t i = 0; i < speed.size(); ++i) {
+    running += speed[i] - (i >= kPeakSmoothingPeriods ? speed[i - kPeakSmoothingPeriods] : 0.0);
+    smooth[i] = running / static_cast<double>(std::min(i + 1, kPeakSmoothingPeriods));
+  }
+  std::size_t rising = 0;
+  while (rising + 1 < smooth.size() && smooth[rising] < 0.5 * steady) {
+    ++rising;
+  }
+  std::size_t peak = rising;
+  bool fell_back = false;
+  for (std::size_t i = rising; i < smooth.size() && !fell_back; ++i) {
+    peak = smooth[i] > smooth[peak] ? i : peak;
+    fell_back = smooth[i] < smooth[peak] - kPeakDropFraction * steady;
+  }
+  if (!fell_back) {
+    peak = rising;
+    while (peak + 1 < smooth.size() && smooth[peak] < steady) {
+      ++peak;
+    }
+  }
+  peak_speed = smooth[peak];
+  return peak;
+}
+
+// The speed's figures from the samples [from, end): the handle's speed along `way` (a unit vector) a
+// period at a time.
+void speed_figures(const std::vector<Sample>& s, std::size_t from, const motion::MachineFrames& frames,
+                   const Eigen::Vector3d& way, WallRow& row) {
+  std::vector<double> t, speed;
+  for (std::size_t i = from + 1; i < s.size(); ++i) {
+    t.push_back(s[i].t_s);
+    speed.push_back((s[i].handle_mm - s[i - 1].handle_mm).dot(way) / (s[i].t_s - s[i - 1].t_s));
+  }
+  if (t.size() < 2) {
+    row.error = "the case ran no periods";
+    return;
+  }
+  double sum = 0.0, lag = 0.0;
+  int n = 0;
+  row.steady_max_device_mm_per_s = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < t.size(); ++i) {
+    if (t[i] > t.back() - kSteadyWindowS) {
+      sum += speed[i];
+      lag += (s[from + 1 + i].handle_mm - motion::world_to_device(frames, s[from + 1 + i].tip_mm)).dot(way);
+      row.steady_max_device_mm_per_s = std::max(row.steady_max_device_mm_per_s, speed[i]);
+      ++n;
+    }
+  }
+  row.held_speed_device_mm_per_s = sum / n;
+  row.lag_device_mm = lag / n;
+  // Under the limit on average and all the time: a hand the cap's spring alone holds averages the
+  // mill's speed itself, its mean over a window above or below with the swing's phase.
+  row.held = row.held_speed_device_mm_per_s < row.limit_device_mm_per_s &&
+             row.steady_max_device_mm_per_s < row.limit_device_mm_per_s;
+  const std::size_t peak = first_speed_peak(speed, row.held_speed_device_mm_per_s, row.first_peak_device_mm_per_s);
+  // What oscillates from 100 ms after it, over the next 200 ms, a period at a time (the jitter too):
+  // the largest departure from the straight line through the speed (a slow settling is not an
+  // oscillation), over the first peak.
+  std::vector<double> window_t, window_speed;
+  for (std::size_t i = peak; i < t.size(); ++i) {
+    if (t[i] >= t[peak] + 0.1 && t[i] <= t[peak] + 0.3) {
+      window_t.push_back(t[i]);
+      window_speed.push_back(speed[i]);
+    }
+  }
+  const double left = detrended_amplitude(window_t, window_speed);
+  row.residual_fraction = row.first_peak_device_mm_per_s > 0.0 ? left / row.first_peak_device_mm_per_s : 0.0;
+  row.stable = row.residual_fraction <= kStableFraction;
+}
+
+// A speed case's cycle: the rig's, its speed cap on (the mill's speed is the point here); the cap
+// alone (previous) or with the penalty (new), nothing else of the wall's feel (no wall is touched).
+// The virtual tool and the handle start in free space, 5 world mm above the top face (the part's
+// highest) and 5 world mm before its middle: the hand's way along +x (at most 20 world mm, 10 s at
+// twice the mill's speed) stays clear of the part and inside the device's reach.
+control::ControllerConfig speed_config(const tables::PartTables& part, const WallCase& c, Eigen::Vector3d& start) {
+  const Face face = top_face(part);
+  control::ControllerConfig config = controller_config(false);
+  config.haptic.coupling_n_per_device_mm = c.coupling_n_per_device_mm;
+  config.feel = engine::WallFeel{};
+  config.feel.transport_delay_s = c.transport_delay_s;
+  if (c.rendering == WallRendering::New) {
+    config.feel.speed_limiting = engine::SpeedLimiting::Penalty;
+    config.feel.speed_penalty_slope_n_s_per_m = c.speed_penalty_slope_n_s_per_m;
+  }
+  config.home_tip_mm = Eigen::Vector3d(face.centre.x() - 5.0, face.centre.y(), face.top_z + config.standoff_mm + 5.0);
+  config.start_held = false;
+  start = motion::world_to_device(config.frames, config.home_tip_mm);
+  return config;
+}
+
+WallRow run_speed_case(const tables::PartTables& part, const WallCase& c) {
+  WallRow row;
+  row.c = c;
+  Eigen::Vector3d start;
+  const control::ControllerConfig config = speed_config(part, c, start);
+  const Eigen::Vector3d way = heading_of(c.heading_deg);
+  row.limit_device_mm_per_s = mill_speed_device_mm_per_s(way);
+  if (!(c.hand.stiffness_n_per_m > 0.0) || !(c.push_n > 0.0)) {
+    row.error = "the hand has no stiffness or no push: it cannot push";
+    return row;
+  }
+  const double lead_mm = 1e3 * c.push_n / c.hand.stiffness_n_per_m;
+  WallBench bench(part, c, config, start);
+  if (!bench.ready()) {
+    row.error = "the cycle is not ready (the tables' tool)";
+    return row;
+  }
+  if (!bench.run_for(config.ramp_time_s + 0.1)) {
+    row.error = safe_state_error(bench, "before the hand moved");
+    return row;
+  }
+  // Until kSpeedSettleS after the hand first pushes with all its push (the relaxed hand's arm takes
+  // seconds to stretch that far), at most kMaxSpeedCaseS.
+  const std::size_t from = bench.samples().size();
+  const double began_s = bench.now_s();
+  bool pushing = false;
+  double pushing_since_s = std::numeric_limits<double>::infinity();
+  while (bench.now_s() - began_s < kMaxSpeedCaseS && bench.now_s() < pushing_since_s + kSpeedSettleS) {
+    push_along(bench, start, way, bench.now_s() - began_s, c.speed_device_mm_per_s, lead_mm, pushing);
+    if (pushing && !std::isfinite(pushing_since_s)) {
+      pushing_since_s = bench.now_s();
+    }
+    if (!bench.step()) {
+      row.error = safe_state_error(bench, "while the hand pushed on");
+      return row;
+    }
+  }
+  speed_figures(bench.samples(), from, bench.frames(), way, row);
+  return row;
+}
+
+// The hand lets go of the handle while pushing with the force limit against the lagging virtual tool:
+// nothing holds the handle but the device's own mass and friction, and the coupling, stretched to the
+// force limit along +x, pulls it back at once with all its force (no ramp). A damper rendered from a
+// lagging velocity on that bare mass is where it rings first.
+WallRow run_release_case(const tables::PartTables& part, const WallCase& c) {
+  WallRow row;
+  row.c = c;
+  row.c.hand = stencil::sim::kNoHand;
+  row.limit_device_mm_per_s = mill_speed_device_mm_per_s(Eigen::Vector3d::UnitX());
+  Eigen::Vector3d start;
+  control::ControllerConfig config = speed_config(part, c, start);
+  const double stretch_device_mm = config.haptic.max_force_n / c.coupling_n_per_device_mm;
+  config.home_tip_mm.x() += stretch_device_mm / config.frames.device_mm_per_world_mm;
+  config.ramp_time_s = 0.0;
+  WallBench bench(part, row.c, config, start);
+  if (!bench.ready()) {
+    row.error = "the cycle is not ready (the tables' tool)";
+    return row;
+  }
+  if (!bench.run_for(kReleaseS)) {
+    row.error = safe_state_error(bench, "while the handle was let go");
+    return row;
+  }
+  speed_figures(bench.samples(), 0, bench.frames(), Eigen::Vector3d::UnitX(), row);
+  return row;
+}
+
 }  // namespace
 
 const char* name_of(WallRendering rendering) { return rendering == WallRendering::New ? "new" : "previous"; }
-const char* name_of(WallTestKind test) { return test == WallTestKind::Slide ? "slide" : "tap"; }
+const char* name_of(WallTestKind test) {
+  switch (test) {
+    case WallTestKind::Slide:
+      return "slide";
+    case WallTestKind::Speed:
+      return "speed";
+    case WallTestKind::Release:
+      return "release";
+    case WallTestKind::Tap:
+      break;
+  }
+  return "tap";
+}
+
+double mill_speed_device_mm_per_s(const Eigen::Vector3d& way) {
+  const control::ControllerConfig config = controller_config(false);
+  const double per_period = config.haptic.device_mm_per_world_mm / config.period_s;
+  return engine::mill_speed_along(way, per_period * config.max_axis_move_mm, per_period * config.max_total_move_mm);
+}
+
+WallCase speed_test_case(const stencil::sim::HandParameters& hand, double coupling_n_per_device_mm,
+                         WallRendering rendering, double speed_factor, double push_n, double heading_deg) {
+  WallCase c;
+  c.hand = hand;
+  c.coupling_n_per_device_mm = coupling_n_per_device_mm;
+  c.rendering = rendering;
+  c.test = WallTestKind::Speed;
+  c.heading_deg = heading_deg;
+  c.speed_device_mm_per_s = speed_factor * mill_speed_device_mm_per_s(heading_of(heading_deg));
+  c.push_n = push_n;
+  c.transport_delay_s = kCanDelayS;
+  return c;
+}
 
 engine::WallFeel new_wall_feel(double coupling_n_per_device_mm, double contact_stiffness_n_per_device_mm,
                                double friction) {
@@ -394,6 +628,12 @@ engine::WallFeel new_wall_feel(double coupling_n_per_device_mm, double contact_s
 }
 
 WallRow run_wall_case(const tables::PartTables& part, const WallCase& c) {
+  if (c.test == WallTestKind::Speed) {
+    return run_speed_case(part, c);
+  }
+  if (c.test == WallTestKind::Release) {
+    return run_release_case(part, c);
+  }
   WallRow row;
   row.c = c;
   const Face face = top_face(part);
@@ -441,7 +681,57 @@ WallRow run_wall_case(const tables::PartTables& part, const WallCase& c) {
   return row;
 }
 
+namespace {
+
+std::string speed_row_json(const WallRow& row) {
+  nlohmann::ordered_json j;
+  j["hand"] = std::string(row.c.hand.name);
+  j["coupling_n_per_device_mm"] = row.c.coupling_n_per_device_mm;
+  j["rendering"] = name_of(row.c.rendering);
+  j["test"] = name_of(row.c.test);
+  if (row.c.test == WallTestKind::Speed) {  // a released handle has no hand to move or push it
+    j["speed_device_mm_per_s"] = row.c.speed_device_mm_per_s;
+    j["heading_deg"] = row.c.heading_deg;
+    j["push_n"] = row.c.push_n;
+  }
+  j["transport_delay_s"] = row.c.transport_delay_s;
+  j["virtual_tool_speed_limit"] = "on";
+  j["speed_limiting"] = row.c.rendering == WallRendering::New ? "penalty" : "cap";
+  j["limit_device_mm_per_s"] = row.limit_device_mm_per_s;
+  j["held_speed_device_mm_per_s"] = row.held_speed_device_mm_per_s;
+  j["steady_max_device_mm_per_s"] = row.steady_max_device_mm_per_s;
+  j["first_peak_device_mm_per_s"] = row.first_peak_device_mm_per_s;
+  j["lag_device_mm"] = row.lag_device_mm;
+  j["residual_fraction"] = row.residual_fraction;
+  j["held"] = row.held;
+  j["stable"] = row.stable;
+  if (!row.error.empty()) {
+    j["error"] = row.error;
+  }
+  return j.dump();
+}
+
+std::string speed_row_text(const WallRow& row) {
+  char line[256];
+  std::snprintf(line, sizeof line, "%-8s %8.2f %-9s %-7s %10.2f %10.3f %10.3f %10.3f %9.3f %8.4f  %-4s %-6s %s",
+                std::string(row.c.hand.name).c_str(), row.c.coupling_n_per_device_mm, name_of(row.c.rendering),
+                name_of(row.c.test), row.limit_device_mm_per_s, row.held_speed_device_mm_per_s,
+                row.steady_max_device_mm_per_s, row.first_peak_device_mm_per_s, row.lag_device_mm,
+                row.residual_fraction, row.held ? "yes" : "NO", row.stable ? "yes" : "NO",
+                row.error.empty() ? "" : ("error: " + row.error).c_str());
+  return line;
+}
+
+}  // namespace
+
+std::string speed_table_header() {
+  return "hand     coupling rendering test    limit_mm/s  held_mm/s   max_mm/s  peak_mm/s    lag_mm residual  held stable";
+}
+
 std::string wall_row_json(const WallRow& row) {
+  if (row.c.test == WallTestKind::Speed || row.c.test == WallTestKind::Release) {
+    return speed_row_json(row);
+  }
   nlohmann::ordered_json j;
   j["hand"] = std::string(row.c.hand.name);
   j["coupling_n_per_device_mm"] = row.c.coupling_n_per_device_mm;
@@ -473,6 +763,9 @@ std::string wall_table_header() {
 }
 
 std::string wall_row_text(const WallRow& row) {
+  if (row.c.test == WallTestKind::Speed || row.c.test == WallTestKind::Release) {
+    return speed_row_text(row);
+  }
   char line[256];
   if (!row.error.empty()) {
     std::snprintf(line, sizeof line, "%-8s %8.2f %-9s %-5s  error: %s", std::string(row.c.hand.name).c_str(),

@@ -213,6 +213,46 @@ TEST(Controller, WithFrictionAToolPressedOnTheFaceStaysWhenPulledSidewaysInsideT
   CHECK(with_friction.device.last_command().force_n[0] < -0.5);  // the hand feels the hold
 }
 
+// Penalty-based speed limiting (issue 29): with the mill's speed cap on (1 world mm/s, 10 device
+// mm/s), a hand moving in free space at 8 device mm/s feels a force against it with the penalty, and
+// nothing with the cap alone (the virtual tool keeps up with it).
+TEST(Controller, WithTheSpeedPenaltyAHandNearTheMillsSpeedIsHeldBackAndWithTheCapAloneItIsNot) {
+  ControllerConfig capped = config();
+  capped.max_axis_move_mm = 1e-3;
+  capped.max_total_move_mm = 1e-3;
+  ControllerConfig penalised = capped;
+  penalised.feel.speed_limiting = engine::SpeedLimiting::Penalty;
+  Bench cap(capped);
+  Bench penalty(penalised);
+  for (Bench* bench : {&cap, &penalty}) {
+    bench->cycles(600);  // past the start-up ramp
+    bench->move_device_to(kHomeDevice + Eigen::Vector3d(2.4, 0.0, 0.0), 8.0);  // 300 periods at 8 mm/s
+  }
+  DOUBLES_EQUAL(0.0, cap.force_written(), 1e-9);
+  // 350 N s/m past a tenth of the limit: 350 x (8 - 1) mm/s = 2.45 N, against the motion.
+  const hal::HapticCommand& held = penalty.device.last_command();
+  DOUBLES_EQUAL(-2.45, held.force_n[0], 0.05);
+  DOUBLES_EQUAL(0.0, held.force_n[1], 1e-9);
+  DOUBLES_EQUAL(0.0, held.force_n[2], 1e-9);
+  CHECK(penalty.controller->safe_reason() == SafeReason::None);
+}
+
+TEST(Controller, TheSpeedPenaltyLeavesSlowMotionAloneAndTheCapStillBoundsTheTool) {
+  ControllerConfig penalised = config();
+  penalised.max_axis_move_mm = 1e-3;
+  penalised.max_total_move_mm = 1e-3;
+  penalised.feel.speed_limiting = engine::SpeedLimiting::Penalty;
+  Bench bench(penalised);
+  bench.cycles(600);
+  bench.move_device_to(kHomeDevice + Eigen::Vector3d(0.0, 0.16, 0.0), 0.8);  // under a tenth of 10 mm/s
+  DOUBLES_EQUAL(0.0, bench.force_written(), 1e-9);
+  // A hand far faster than the mill: the penalty at the force limit, and the tool no faster than the cap.
+  const Eigen::Vector3d before = bench.controller->virtual_tip_mm();
+  bench.move_device_to(bench.device_position() + Eigen::Vector3d(0.0, 10.0, 0.0), 100.0);
+  CHECK((bench.controller->virtual_tip_mm() - before).cwiseAbs().sum() <= 101 * 1e-3 + 1e-12);
+  DOUBLES_EQUAL(5.0, bench.force_written(), 1e-9);
+}
+
 TEST(Controller, AStaleDeviceForMoreThanFivePeriodsEntersTheSafeState) {
   Bench bench;
   bench.cycles(20);

@@ -35,12 +35,15 @@ int main() {
   config.device_low_mm = Eigen::Vector3d(-25.0, -25.0, -25.0);
   config.device_high_mm = Eigen::Vector3d(525.0, 275.0, 275.0);
   config.home_tip_mm = Eigen::Vector3d(25.0, 12.5, 20.0);
-  // The wall's feel on (issue 29): the damper, the passivity controller and friction run in the
-  // trapped cycles too (today's rendering calls nothing they do not).
+  // The wall's feel on (issue 29): the damper, the passivity controller, friction and the speed
+  // penalty with its velocity predictor run in the trapped cycles too (today's rendering calls nothing
+  // they do not). The penalty renders from the speed limit's change on: the hand circles at about
+  // 12 world mm/s, past the 8 it is then held to.
   config.feel.damping_n_s_per_m = 3.0;
   config.feel.passivity = true;
   config.feel.friction = 0.5;
   config.feel.transport_delay_s = 0.7e-3;
+  config.feel.speed_limiting = engine::SpeedLimiting::Penalty;
   auto controller = std::make_unique<control::Controller>(
       part, device, control::CycleRings{commands, machine_events, handoffs, telemetry, journal, taken, &display_commands}, config);
   if (!controller->ready()) {
@@ -62,7 +65,7 @@ int main() {
     }
     if (i == kCycles / 8 + 200) {
       static_cast<void>(display_commands.push({control::CommandKind::Resume, 0.0, control::CommandSource::Display}));
-      static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimit, 20.0, control::CommandSource::Display}));
+      static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimit, 8.0, control::CommandSource::Display}));
     }
     if (i == kCycles / 2) {
       static_cast<void>(commands.push({control::CommandKind::Stop, 0.0, control::CommandSource::Terminal}));

@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "firmware/core/motion/machine_planner.hpp"
+#include "firmware/core/stencil/speed_penalty.hpp"
 #include "firmware/core/stencil/surface_friction.hpp"
 
 namespace stencil::control {
@@ -53,6 +54,7 @@ Controller::Controller(const tables::PartTables& part, hal::HapticDevice& device
   waiting_for_hand_ = config.start_held;
   stretch_rate_.configure(config.feel.velocity_cutoff_hz, config.period_s);
   handle_velocity_.configure(config.feel.velocity_cutoff_hz, config.period_s);
+  speed_predictor_.configure(handle_velocity_.alpha(), config.period_s, config.feel.transport_delay_s);
 }
 
 ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
@@ -453,8 +455,12 @@ Controller::EngineOutcome Controller::run_engine(bool usable) {
       paused_ ? engine::RemediationResult{engine::RemediationStatus::Stuck, tool_.tip_mm(), 0, 0, false}
               : move_tool(desired, outcome.contact);
   outcome.remediation = moved.status;
-  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic,
-                                         wall_damping(outcome.device_mm, desired, outcome.contact));
+  // The damping first: it moves the handle's velocity estimate the penalty reads.
+  Eigen::Vector3d added_force = wall_damping(outcome.device_mm, desired, outcome.contact);
+  if (config_.feel.speed_limiting == engine::SpeedLimiting::Penalty) {
+    added_force += speed_penalty();
+  }
+  outcome.output = engine::haptic_output(desired, tool_.tip_mm(), outcome.contact, config_.haptic, added_force);
   if (outcome.contact.status != engine::QueryStatus::Ok || moved.status == engine::RemediationStatus::Fault ||
       outcome.output.fault) {
     enter_safe_state(SafeReason::EngineFault);
@@ -500,7 +506,7 @@ engine::RemediationResult Controller::move_tool(const Eigen::Vector3d& desired, 
 Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const Eigen::Vector3d& desired,
                                          const engine::ContactResult& contact) {
   const engine::WallFeel& feel = config_.feel;
-  if (!(feel.damping_n_s_per_m > 0.0) && !feel.passivity) {
+  if (!(feel.damping_n_s_per_m > 0.0) && !feel.passivity && feel.speed_limiting != engine::SpeedLimiting::Penalty) {
     return Eigen::Vector3d::Zero();
   }
   const Eigen::Vector3d stretch_m = 1e-3 * config_.haptic.device_mm_per_world_mm * (tool_.tip_mm() - desired);
@@ -513,6 +519,9 @@ Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const
     const double elapsed_s = have_last_handle_ ? static_cast<double>(sample_time_ns_ - last_handle_ns_) / kNsPerS : 0.0;
     static_cast<void>(stretch_rate_.update(stretch_m, elapsed_s));
     static_cast<void>(handle_velocity_.update(handle_m, elapsed_s));
+    if (feel.speed_limiting == engine::SpeedLimiting::Penalty) {
+      speed_predictor_.sample(elapsed_s);  // with the filter, as it took the sample
+    }
     if (feel.passivity) {
       if (penetrating && !was_penetrating_) {
         passivity_.forget_absorbed();  // a contact starts: its balance is its own, less any debt
@@ -562,9 +571,24 @@ Eigen::Vector3d Controller::wall_damping(const Eigen::Vector3d& device_mm, const
   return force;
 }
 
+Eigen::Vector3d Controller::speed_penalty() {
+  // The cap's per-period moves (world mm), as the speed they allow at the handle (device m/s): the
+  // operator's speed limit as it stands, not the backlog's slowing, which comes and goes with the mill.
+  const double device_m_per_s = 1e-3 * config_.haptic.device_mm_per_world_mm / config_.period_s;
+  // On the velocity past the filter's lag: on the filtered one the slope the law needs rings.
+  const Eigen::Vector3d velocity = speed_predictor_.predict(handle_velocity_.value());
+  const double limit = engine::mill_speed_along(velocity, device_m_per_s * config_.max_axis_move_mm,
+                                                device_m_per_s * config_.max_total_move_mm);
+  const Eigen::Vector3d penalty =
+      engine::speed_penalty_n(velocity, limit, config_.haptic.max_force_n, config_.feel.speed_penalty_slope_n_s_per_m);
+  speed_predictor_.commit(penalty);
+  return penalty;
+}
+
 void Controller::restart_wall_feel() {
   stretch_rate_.reset();
   handle_velocity_.reset();
+  speed_predictor_.reset();
   passivity_.restart();
   have_last_handle_ = false;
   was_penetrating_ = false;

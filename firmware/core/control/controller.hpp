@@ -18,6 +18,7 @@
 #include "firmware/core/stencil/passivity_controller.hpp"
 #include "firmware/core/stencil/triangle_set.hpp"
 #include "firmware/core/stencil/velocity_filter.hpp"
+#include "firmware/core/stencil/velocity_predictor.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/part_tables.hpp"
 #include "hal/haptic_device.hpp"
@@ -171,9 +172,14 @@ class Controller {
   // Where the virtual tool goes this cycle and how: towards the hand, or as the friction cone lets it.
   [[nodiscard]] engine::RemediationResult move_tool(const Eigen::Vector3d& desired, const engine::ContactResult& contact);
   // The wall's damping this cycle (N): the coupling's virtual damper and the passivity controller's
-  // correction; zero with both off (today's rendering: nothing is computed).
+  // correction; zero with both off (today's rendering: nothing is computed, unless the speed penalty
+  // needs the handle's velocity estimate, which this moves).
   [[nodiscard]] Eigen::Vector3d wall_damping(const Eigen::Vector3d& device_mm, const Eigen::Vector3d& desired,
                                              const engine::ContactResult& contact);
+  // Penalty-based speed limiting (config_.feel.speed_limiting): the force against the handle's
+  // velocity as it nears the speed the mill can follow (engine/speed_penalty.hpp), from the estimate
+  // wall_damping() has just moved, predicted past its lag by the forces this has rendered.
+  [[nodiscard]] Eigen::Vector3d speed_penalty();
   // The estimates start again (after any cycle that rendered no force): no stale velocity, no old balance.
   void restart_wall_feel();
   [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
@@ -228,6 +234,7 @@ class Controller {
   // device metres per second), the energy balance, and the handle's last position.
   engine::VelocityFilter stretch_rate_;
   engine::VelocityFilter handle_velocity_;
+  engine::VelocityPredictor speed_predictor_;  // the handle's velocity past the filter's lag, for the penalty
   engine::PassivityController passivity_;
   Eigen::Vector3d last_handle_m_ = Eigen::Vector3d::Zero();
   hal::MonotonicNs last_handle_ns_ = 0;  // when that sample was read

@@ -7,6 +7,7 @@
 #include <Eigen/Core>
 
 #include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/speed_penalty.hpp"
 
 namespace stencil::engine {
 
@@ -43,6 +44,9 @@ struct WallFeel {
   // commands by it for the force the device really held over the period.
   double transport_delay_s = 0.0;
   SpeedLimiting speed_limiting = SpeedLimiting::Cap;
+  // Penalty: how steeply it rises with the hand's speed, N s per device metre (speed_penalty.hpp says
+  // why this steep and no steeper).
+  double speed_penalty_slope_n_s_per_m = kSpeedPenaltySlopeNSPerM;
 };
 
 struct HapticOutput {

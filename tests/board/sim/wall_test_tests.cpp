@@ -1,5 +1,6 @@
 // The wall's feel, measured (board/sim/wall_test.hpp): taps and slides through the real cycle with a
-// simulated hand, on the hex prism's top face.
+// simulated hand, on the hex prism's top face; and above it, a hand pushing on faster than the mill
+// follows, and a handle let go.
 #include <cmath>
 #include <string>
 
@@ -83,4 +84,64 @@ TEST(WallTest, ARowIsOneLineOfJsonWithTheIssuesFields) {
   }
   CHECK(json.find('\n') == std::string::npos);
   CHECK(json.find("friction_ratio") == std::string::npos);  // a tap has none
+}
+
+// Issue 29's done-when: a hand whose intent runs at twice the mill's speed, pushing with 2 N, is held
+// under the mill's speed by the penalty, with no oscillation; the cap alone lets it run past.
+TEST(WallTest, WithTheSpeedPenaltyAHandPushingOnAtTwiceTheMillsSpeedIsHeldUnderItStably) {
+  const Prism prism;
+  const WallRow row =
+      run_wall_case(prism.part, speed_test_case(stencil::sim::kRelaxedHand, 0.5, WallRendering::New, 2.0, 2.0));
+  STRCMP_EQUAL("", row.error.c_str());
+  DOUBLES_EQUAL(10.0, row.limit_device_mm_per_s, 1e-9);  // the rig: 1 world mm/s at 10 device mm per world mm
+  CHECK(row.held);
+  CHECK(row.held_speed_device_mm_per_s < 0.9 * row.limit_device_mm_per_s);
+  CHECK(row.steady_max_device_mm_per_s < row.limit_device_mm_per_s);
+  CHECK(row.stable);
+  CHECK(std::fabs(row.lag_device_mm) < 0.01);  // the virtual tool keeps up with the held hand
+}
+
+TEST(WallTest, AlongAHorizontalDiagonalWhereTheMillFollowsLeastTheHandIsHeldUnderItToo) {
+  const Prism prism;
+  const WallRow row = run_wall_case(
+      prism.part, speed_test_case(stencil::sim::kRelaxedHand, 0.5, WallRendering::New, 2.0, 2.0, 45.0));
+  STRCMP_EQUAL("", row.error.c_str());
+  DOUBLES_EQUAL(10.0 / std::sqrt(2.0), row.limit_device_mm_per_s, 1e-9);  // |dx| + |dy| at most the mill's speed
+  CHECK(row.held);
+  CHECK(row.stable);
+}
+
+TEST(WallTest, WithTheCapAloneTheHandRunsPastTheMillsSpeedDraggingTheLaggingTool) {
+  const Prism prism;
+  const WallRow row =
+      run_wall_case(prism.part, speed_test_case(stencil::sim::kMediumHand, 0.5, WallRendering::Previous, 2.0, 2.0));
+  STRCMP_EQUAL("", row.error.c_str());
+  CHECK_FALSE(row.held);
+  CHECK(row.steady_max_device_mm_per_s > row.limit_device_mm_per_s);
+  CHECK(row.first_peak_device_mm_per_s > 1.5 * row.limit_device_mm_per_s);
+  DOUBLES_EQUAL(2.0 / 0.5, row.lag_device_mm, 0.5);  // the coupling stretched to the push
+}
+
+TEST(WallTest, AHandleLetGoWhereTheCouplingPullsWithTheForceLimitComesToRestWithThePenalty) {
+  const Prism prism;
+  WallCase c = speed_test_case(stencil::sim::kRelaxedHand, 2.0, WallRendering::New, 2.0, 2.0);
+  c.test = WallTestKind::Release;
+  const WallRow row = run_wall_case(prism.part, c);
+  STRCMP_EQUAL("", row.error.c_str());
+  CHECK(row.stable);
+  DOUBLES_EQUAL(0.0, row.steady_max_device_mm_per_s, 1e-9);
+}
+
+TEST(WallTest, ASpeedRowIsOneLineOfJsonWithItsOwnFields) {
+  WallRow row;
+  row.c = speed_test_case(stencil::sim::kStiffHand, 1.0, WallRendering::New, 2.0, 2.0);
+  row.limit_device_mm_per_s = 10.0;
+  row.held = true;
+  const std::string json = wall_row_json(row);
+  for (const char* field : {"\"test\":\"speed\"", "\"speed_limiting\":\"penalty\"", "\"virtual_tool_speed_limit\":\"on\"",
+                            "\"limit_device_mm_per_s\":10.0", "\"held_speed_device_mm_per_s\"", "\"held\":true",
+                            "\"residual_fraction\"", "\"stable\"", "\"speed_device_mm_per_s\":20.0"}) {
+    CHECK_TEXT(json.find(field) != std::string::npos, field);
+  }
+  CHECK(json.find("rebound_mm") == std::string::npos);  // a tap's, not a speed case's
 }
