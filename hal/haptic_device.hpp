@@ -16,6 +16,15 @@ inline constexpr std::uint32_t kCommandRejected = 1U << 2;      // the last comm
 inline constexpr std::uint32_t kDeviceFault = 1U << 3;          // the device's own fault (amplifier, encoder)
 }  // namespace haptic_status
 
+// Each link's expected delay from the cycle's command to the device's motors (s), estimated, not
+// measured on a rig: the passivity observer and the speed penalty's velocity predictor weigh the
+// force by it. PIO: the device's own 1 kHz loop reads the window at a phase of its own, on average
+// half a period later. CAN: the two command frames (0x100, 0x101: 8 data bytes, about 130 bits each
+// with stuffing) take 0.26 ms at 1 Mbit/s, after the device's three pose frames of the same period
+// (0.4 ms): 0.7 ms (hal/socketcan/can_bus_load.hpp counts the bits).
+inline constexpr double kPioCommandDelayS = 0.5e-3;
+inline constexpr double kCanCommandDelayS = 0.7e-3;
+
 // One pose sample, in device coordinates (origin at the centre of the device's reach).
 struct HapticSample {
   double position_mm[3];         // x y z

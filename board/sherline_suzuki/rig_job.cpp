@@ -86,6 +86,7 @@ control::ControllerConfig rig_controller_config(const RigJob& job) {
   config.start_held = job.facts.start_held;  // no tool motion and no force until the hand is held still near the tool
   config.overrun_limit = job.facts.overrun_limit;
   config.stale_periods = job.facts.stale_periods;
+  config.feel.transport_delay_s = job.device_delay_s;  // the wall's feel weighs the force by it
   return config;
 }
 

@@ -45,6 +45,7 @@ struct RigJob {
   RigFacts facts = kRig;                // the rig: compiled in, or from its configuration file (rig_config.hpp)
   const tables::PartTables* part = nullptr;
   hal::HapticDevice* device = nullptr;
+  double device_delay_s = 0.0;          // its link's command-to-motor delay (hal::kPioCommandDelayS, ...)
   hal::MachineLink* machine = nullptr;
   hal::Clock* machine_clock = nullptr;  // the link's clock: the machine thread paces on it
   WorkOffset offset;

@@ -87,6 +87,10 @@ runtime::JobParts parts_of(const SimJob& job, SimMachine& mill, hal::HapticDevic
   parts.machine = &mill.link();
   parts.machine_clock = &mill.clock();
   parts.controller = controller_config(realtime, job.rig);
+  // The wall's feel weighs the force by the link's delay, as the rig expects it for that link.
+  parts.controller.feel.transport_delay_s = job.transport == HapticTransport::Pio   ? hal::kPioCommandDelayS
+                                            : job.transport == HapticTransport::Can ? hal::kCanCommandDelayS
+                                                                                    : 0.0;
   parts.planner = rig::planner_limits(job.rig.facts);
   parts.period_ns = rig::period_ns(job.rig.facts);
   parts.update_ns = rig::update_ns(job.rig.facts);

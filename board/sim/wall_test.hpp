@@ -12,6 +12,7 @@
 
 #include "firmware/core/stencil/haptic_force.hpp"
 #include "firmware/core/tables/part_tables.hpp"
+#include "hal/haptic_device.hpp"
 #include "sim/operator/hand_device_model.hpp"
 
 namespace stencil::board::sim {
@@ -31,14 +32,11 @@ enum class WallTestKind : std::uint8_t { Tap, Slide, Speed, Release };
 // The couplings the display allows, low to high (N per device mm; control::ControllerConfig's range).
 inline constexpr double kWallCouplings[] = {0.05, 0.1, 0.2, 0.5, 1.0, 2.0};
 
-// Each transport's delay from the cycle's command to the device's motors (s), for --transport.
-// direct: in process, none. pio: the device's own 1 kHz loop reads the window at a phase of its own,
-// on average half a period later. can: the two command frames (0x100, 0x101: 8 data bytes, about
-// 130 bits each with stuffing) take 0.26 ms at 1 Mbit/s, after the device's three pose frames of the
-// same period (0.4 ms): 0.7 ms (hal/socketcan/can_bus_load.hpp counts the bits).
+// Each transport's delay from the cycle's command to the device's motors (s), for --transport:
+// direct, in process, none; pio and can as the rig expects them (hal/haptic_device.hpp).
 inline constexpr double kDirectDelayS = 0.0;
-inline constexpr double kPioDelayS = 0.5e-3;
-inline constexpr double kCanDelayS = 0.7e-3;
+inline constexpr double kPioDelayS = hal::kPioCommandDelayS;
+inline constexpr double kCanDelayS = hal::kCanCommandDelayS;
 
 struct WallCase {
   stencil::sim::HandParameters hand = stencil::sim::kMediumHand;

@@ -347,6 +347,8 @@ int main(int argc, char** argv) {
   if (o.require_rt && (!readiness.preempt_rt || !readiness.can_sched_fifo)) {
     return fail(kExitNotStarted, "--require-rt: this host has no PREEMPT_RT kernel or may not use SCHED_FIFO");
   }
+  // The link's command-to-motor delay, which the wall's feel weighs the force by.
+  job.device_delay_s = o.haptic.rfind("can:", 0) == 0 ? hal::kCanCommandDelayS : hal::kPioCommandDelayS;
   board::sherline_suzuki::RigDevices devices;
   if (!board::sherline_suzuki::open_rig_devices(job.facts, o.serial_path, o.haptic, devices, [](const std::string& note) {
         std::printf("stencil-rig: %s\n", note.c_str());

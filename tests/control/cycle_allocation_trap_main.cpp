@@ -67,6 +67,12 @@ int main() {
       static_cast<void>(display_commands.push({control::CommandKind::Resume, 0.0, control::CommandSource::Display}));
       static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimit, 8.0, control::CommandSource::Display}));
     }
+    if (i == kCycles / 4) {
+      // The wall's feel changed live (the estimates restart): no allocation either.
+      static_cast<void>(display_commands.push({control::CommandKind::SetDamping, 45.0, control::CommandSource::Display}));
+      static_cast<void>(display_commands.push({control::CommandKind::SetFriction, 0.3, control::CommandSource::Display}));
+      static_cast<void>(display_commands.push({control::CommandKind::SetSpeedLimiting, 1.0, control::CommandSource::Display}));
+    }
     if (i == kCycles / 2) {
       static_cast<void>(commands.push({control::CommandKind::Stop, 0.0, control::CommandSource::Terminal}));
       held = 10.0 * controller->virtual_tip_mm();
@@ -104,9 +110,9 @@ int main() {
               cycles, trapped, controller->touched().count(),
               static_cast<unsigned long long>(controller->counters().safe_state_entries),
               static_cast<unsigned long long>(controller->counters().resets_accepted), commands_taken);
-  // Pause, resume, the speed, the stop and the reset: each done.
+  // Pause, resume, the speed, the wall's three, the stop and the reset: each done.
   const bool exercised = controller->touched().count() > 0 && controller->counters().safe_state_entries == 1 &&
-                         controller->counters().resets_accepted == 1 && commands_taken == 5;
+                         controller->counters().resets_accepted == 1 && commands_taken == 8;
   std::printf("%lu passed, %lu failed\n", trapped == 0 && exercised ? 1ul : 0ul, trapped == 0 && exercised ? 0ul : 1ul);
   return trapped == 0 && exercised ? 0 : 1;
 }

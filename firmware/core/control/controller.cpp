@@ -87,6 +87,7 @@ ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
       // The passivity controller goes with the damping: on, it takes back what the damper's delay
       // and the sampling put in; off, today's rendering exactly.
       config_.feel.passivity = applied > 0.0;
+      restart_wall_feel();  // estimates kept while the feel was off are stale
       return applied == value ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
     }
     case CommandKind::SetFriction: {
@@ -98,6 +99,7 @@ ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
         return ParameterOutcome::Refused;
       }
       config_.feel.speed_limiting = value == 0.0 ? engine::SpeedLimiting::Cap : engine::SpeedLimiting::Penalty;
+      restart_wall_feel();
       return ParameterOutcome::Applied;
     default:
       return ParameterOutcome::Refused;
