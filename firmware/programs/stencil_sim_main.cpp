@@ -298,16 +298,23 @@ bool make_job(const app::SimOptions& o, const tables::PartTables& part, board::s
       job_text += " hand=" + o.hand;
     }
   }
-  // The wall's feel as the operator's commands before the first cycle; none given, none sent.
+  // The wall's feel as the operator's commands before the first cycle; none given, none sent. Part of
+  // the job: a resume must give the same (the text is as before without them).
   constexpr auto kProgram = control::CommandSource::Program;
+  char feel[96] = "";
   if (o.damping_n_s_per_m > 0.0) {
     job.opening_commands.push_back({control::CommandKind::SetDamping, o.damping_n_s_per_m, kProgram});
+    std::snprintf(feel, sizeof feel, " damping=%.17g", o.damping_n_s_per_m);
+    job_text += feel;
   }
   if (o.friction > 0.0) {
     job.opening_commands.push_back({control::CommandKind::SetFriction, o.friction, kProgram});
+    std::snprintf(feel, sizeof feel, " friction=%.17g", o.friction);
+    job_text += feel;
   }
   if (o.speed_limiting == "penalty") {
     job.opening_commands.push_back({control::CommandKind::SetSpeedLimiting, 1.0, kProgram});
+    job_text += " speed_limiting=penalty";
   }
   if (job_text.size() > 1024) {
     error = "--tables and --operator: paths too long to record in the journal (" + std::to_string(job_text.size()) +
@@ -616,6 +623,11 @@ int main(int argc, char** argv) {
     return cut_directly(o, part, job, program, provenance);
   }
   report::JobFolder folder;
+  // Before a replay too: the wall's feel weighs the force by the link's delay, so a job run over PIO
+  // or CAN with the feel on is replayed with the same --haptic-transport for the same forces.
+  job.transport = o.transport == "pio"   ? board::sim::HapticTransport::Pio
+                  : o.transport == "can" ? board::sim::HapticTransport::Can
+                                         : board::sim::HapticTransport::Direct;
   if (!o.replay_path.empty()) {
     return place_outputs(o, 0, folder, error)
                ? replay(o.replay_path, part, job, o.report_path, o.stock_csv_path, o.fast ? 0.0 : o.speed, provenance)
@@ -639,9 +651,6 @@ int main(int argc, char** argv) {
     folder.abandon();
     return bad_input(message);
   };
-  job.transport = o.transport == "pio"   ? board::sim::HapticTransport::Pio
-                  : o.transport == "can" ? board::sim::HapticTransport::Can
-                                         : board::sim::HapticTransport::Direct;
   job.duration_s = o.duration_s;
   job.fault = o.fault;
   job.until_complete = o.until_complete;

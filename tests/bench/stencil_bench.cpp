@@ -13,6 +13,7 @@
 #include "firmware/core/stencil/contact_query.hpp"
 #include "firmware/core/stencil/haptic_force.hpp"
 #include "firmware/core/stencil/passivity_controller.hpp"
+#include "firmware/core/stencil/speed_penalty.hpp"
 #include "firmware/core/stencil/surface_friction.hpp"
 #include "firmware/core/stencil/velocity_filter.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
@@ -150,7 +151,8 @@ int main(int argc, char** argv) {
           "--state free|light|deep|deep-corner: only that state (for profiling one case).\n"
           "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
           "timed the same way, so the machine's own tail can be told from the code's.\n"
-          "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity), on\n"
+          "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
+          "speed penalty), on\n"
           "its longest path (the probe under a resting tool and the query at the friction's goal).\n"
           "--json: one JSON object per line.\n");
       return argument == "--help" || argument == "-h" ? 0 : 2;
@@ -228,7 +230,8 @@ int main(int argc, char** argv) {
       // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
       // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
       // the part slides), the probe under the resting tool and the query at the friction's goal, then
-      // the velocity filters, the damper and the passivity observer and controller, and the force.
+      // the velocity filters, the damper, the passivity observer and controller, the speed penalty
+      // (its velocity predictor left out: a few multiplications), and the force.
       const Timing felt = measure(
           [&] {
             engine::VirtualTool tool(part, state.resting);
@@ -255,10 +258,11 @@ int main(int argc, char** argv) {
             static_cast<void>(stretch_rate.update(stretch));
             static_cast<void>(handle_velocity.update(1e-2 * state.desired));
             static_cast<void>(passivity.observe(contact.force_n, 1e-5 * Eigen::Vector3d::Ones()));
-            const Eigen::Vector3d added =
-                30.0 * stretch_rate.update(stretch + Eigen::Vector3d::Constant(1e-6)) +
-                passivity.correction(handle_velocity.update(1e-2 * state.desired + Eigen::Vector3d::Constant(1e-5)),
-                                     1e-3, 5.0);
+            const Eigen::Vector3d velocity =
+                handle_velocity.update(1e-2 * state.desired + Eigen::Vector3d::Constant(1e-5));
+            const Eigen::Vector3d added = 30.0 * stretch_rate.update(stretch + Eigen::Vector3d::Constant(1e-6)) +
+                                          passivity.correction(velocity, 1e-3, 5.0) +
+                                          engine::speed_penalty_n(velocity, engine::mill_speed_along(velocity, 0.01, 0.01), 5.0);
             const engine::HapticOutput out =
                 engine::haptic_output(state.desired, result.tip_mm, contact, engine::HapticLimits{}, added);
             sink = sink + contact.max_depth_mm + result.tip_mm.z() + out.force_n.x();

@@ -125,7 +125,7 @@ TEST(RequestRules, TheWallsFeelTakesZeroAndIsBoundedByItsOwnRange) {
     CHECK_FALSE(refusal({RequestKind::Set, p, std::nan("")}, limits).empty());
   }
   CHECK(refusal({RequestKind::Set, Parameter::Damping, 100.0}, limits).empty());
-  STRCMP_EQUAL("150 N s/m is above the most damping the cycle renders stably, 100 N s/m",
+  STRCMP_EQUAL("150 N s/m is above the most damping the cycle takes, 100 N s/m",
                refusal({RequestKind::Set, Parameter::Damping, 150.0}, limits).c_str());
   STRCMP_EQUAL("damping must be a number of at least 0", refusal({RequestKind::Set, Parameter::Damping, -1.0}, limits).c_str());
   CHECK(refusal({RequestKind::Set, Parameter::Friction, 0.5}, limits).empty());
@@ -133,6 +133,8 @@ TEST(RequestRules, TheWallsFeelTakesZeroAndIsBoundedByItsOwnRange) {
                refusal({RequestKind::Set, Parameter::Friction, 1.2}, limits).c_str());
   STRCMP_EQUAL("speed limiting 0.5: expected 0 (the cap) or 1 (the penalty)",
                refusal({RequestKind::Set, Parameter::SpeedLimiting, 0.5}, limits).c_str());
+  STRCMP_EQUAL("speed limiting -1: expected 0 (the cap) or 1 (the penalty)",
+               refusal({RequestKind::Set, Parameter::SpeedLimiting, -1.0}, limits).c_str());
   const control::Command penalty = command_of({RequestKind::Set, Parameter::SpeedLimiting, 1.0});
   CHECK(penalty.kind == control::CommandKind::SetSpeedLimiting);
   DOUBLES_EQUAL(1.0, penalty.value, 0.0);

@@ -83,11 +83,13 @@ ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
     }
     case CommandKind::SetDamping: {
       const double applied = std::min(value, config_.max_damping_n_s_per_m);
-      config_.feel.damping_n_s_per_m = applied;
-      // The passivity controller goes with the damping: on, it takes back what the damper's delay
-      // and the sampling put in; off, today's rendering exactly.
-      config_.feel.passivity = applied > 0.0;
-      restart_wall_feel();  // estimates kept while the feel was off are stale
+      if (applied != config_.feel.damping_n_s_per_m) {
+        config_.feel.damping_n_s_per_m = applied;
+        // The passivity controller goes with the damping: on, it takes back what the damper's delay
+        // and the sampling put in; off, today's rendering exactly.
+        config_.feel.passivity = applied > 0.0;
+        restart_feel_estimates();
+      }
       return applied == value ? ParameterOutcome::Applied : ParameterOutcome::Clamped;
     }
     case CommandKind::SetFriction: {
@@ -98,8 +100,13 @@ ParameterOutcome Controller::set_parameter(CommandKind kind, double value) {
       if (value != 0.0 && value != 1.0) {
         return ParameterOutcome::Refused;
       }
-      config_.feel.speed_limiting = value == 0.0 ? engine::SpeedLimiting::Cap : engine::SpeedLimiting::Penalty;
-      restart_wall_feel();
+      {
+        const engine::SpeedLimiting mode = value == 0.0 ? engine::SpeedLimiting::Cap : engine::SpeedLimiting::Penalty;
+        if (mode != config_.feel.speed_limiting) {
+          config_.feel.speed_limiting = mode;
+          restart_feel_estimates();
+        }
+      }
       return ParameterOutcome::Applied;
     default:
       return ParameterOutcome::Refused;
@@ -585,6 +592,14 @@ Eigen::Vector3d Controller::speed_penalty() {
       engine::speed_penalty_n(velocity, limit, config_.haptic.max_force_n, config_.feel.speed_penalty_slope_n_s_per_m);
   speed_predictor_.commit(penalty);
   return penalty;
+}
+
+void Controller::restart_feel_estimates() {
+  // As restart_wall_feel, but a tool resting on the part stays held by its friction: only the
+  // estimates kept while the feel was otherwise (stale, or never taken) start again.
+  const bool resting = tool_on_surface_;
+  restart_wall_feel();
+  tool_on_surface_ = resting;
 }
 
 void Controller::restart_wall_feel() {

@@ -60,9 +60,9 @@ struct ControllerConfig {
   double min_coupling_n_per_device_mm = 0.05;
   double max_coupling_n_per_device_mm = 2.0;
   // The most virtual damping the operator may set (N s per device metre). The wall test's damping
-  // at the stiffest coupling is 10 + 21 x 3 = 73; a damper sampled at 1 kHz on the device's 0.2 kg
-  // alone stays stable below 2 m / T = 400, so this leaves the hand's own mass and the velocity
-  // filter's lag a margin of four.
+  // at the stiffest coupling is 10 + 21 x 3 = 73, and nothing above that was measured; a damper on
+  // the filtered velocity goes unstable near b T / m = 1 (velocity_predictor.hpp), 200 N s/m on the
+  // device's 0.2 kg alone, so this keeps a margin of two even with no hand on the handle.
   double max_damping_n_s_per_m = 100.0;
 };
 
@@ -182,6 +182,8 @@ class Controller {
   [[nodiscard]] Eigen::Vector3d speed_penalty();
   // The estimates start again (after any cycle that rendered no force): no stale velocity, no old balance.
   void restart_wall_feel();
+  // A change of the feel's parameters: the estimates start again, a resting tool stays held.
+  void restart_feel_estimates();
   [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
   [[nodiscard]] Telemetry build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
                                           const EngineOutcome& outcome) const;

@@ -77,7 +77,11 @@ std::string refusal(const Request& request, const RequestLimits& limits) {
   const double value = request.value;
   const std::string unit = parameter_unit(request.parameter);
   const control::CommandKind kind = command_kind(request.parameter);
-  if (control::zero_allowed(kind)) {
+  if (request.parameter == Parameter::SpeedLimiting) {
+    if (value != 0.0 && value != 1.0) {
+      return "speed limiting " + number(value) + ": expected 0 (the cap) or 1 (the penalty)";
+    }
+  } else if (control::zero_allowed(kind)) {
     if (!std::isfinite(value) || value < 0.0) {
       return std::string(control::parameter_name(kind)) + " must be a number of at least 0";
     }
@@ -104,7 +108,7 @@ std::string refusal(const Request& request, const RequestLimits& limits) {
       break;
     case Parameter::Damping:
       if (value > limits.max_damping_n_s_per_m) {
-        return number(value) + " N s/m is above the most damping the cycle renders stably, " +
+        return number(value) + " N s/m is above the most damping the cycle takes, " +
                number(limits.max_damping_n_s_per_m) + " N s/m";
       }
       break;
