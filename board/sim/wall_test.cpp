@@ -282,6 +282,20 @@ bool ramp_pull(WallBench& bench, const Eigen::Vector3d& from, double pull_n) {
   return false;
 }
 
+// The cycle ready and the force's ramp after the start waited out (the first half second), the
+// hand still; false with row.error when not.
+bool started(WallBench& bench, const control::ControllerConfig& config, WallRow& row) {
+  if (!bench.ready()) {
+    row.error = "the cycle is not ready (the tables' tool)";
+    return false;
+  }
+  if (!bench.run_for(config.ramp_time_s + 0.1)) {
+    row.error = safe_state_error(bench, "before the hand moved");
+    return false;
+  }
+  return true;
+}
+
 // Dragged along the face (device +x) from `pressed`: the friction felt while the tool slides, in
 // row.friction_ratio. False with row.error when it never slid or the cycle stopped.
 bool drag_along_face(WallBench& bench, const WallCase& c, const Eigen::Vector3d& pressed, WallRow& row) {
@@ -525,12 +539,7 @@ WallRow run_speed_case(const tables::PartTables& part, const WallCase& c) {
   }
   const double lead_mm = 1e3 * c.push_n / c.hand.stiffness_n_per_m;
   WallBench bench(part, c, config, start);
-  if (!bench.ready()) {
-    row.error = "the cycle is not ready (the tables' tool)";
-    return row;
-  }
-  if (!bench.run_for(config.ramp_time_s + 0.1)) {
-    row.error = safe_state_error(bench, "before the hand moved");
+  if (!started(bench, config, row)) {
     return row;
   }
   // Until kSpeedSettleS after the hand first pushes with all its push (the relaxed hand's arm takes
@@ -664,13 +673,7 @@ WallRow run_wall_case(const tables::PartTables& part, const WallCase& c) {
   }
   const double push_depth_mm = c.push_n / hand_n_per_mm + c.push_n / wall_n_per_mm;
   WallBench bench(part, c, config, start);
-  if (!bench.ready()) {
-    row.error = "the cycle is not ready (the tables' tool)";
-    return row;
-  }
-  // The force ramps in over the first half second after a start: the hand waits it out, still.
-  if (!bench.run_for(config.ramp_time_s + 0.1)) {
-    row.error = safe_state_error(bench, "before the hand moved");
+  if (!started(bench, config, row)) {
     return row;
   }
   if (c.test == WallTestKind::Tap) {

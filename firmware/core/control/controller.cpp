@@ -595,14 +595,6 @@ Eigen::Vector3d Controller::speed_penalty() {
 }
 
 void Controller::restart_feel_estimates() {
-  // As restart_wall_feel, but a tool resting on the part stays held by its friction: only the
-  // estimates kept while the feel was otherwise (stale, or never taken) start again.
-  const bool resting = tool_on_surface_;
-  restart_wall_feel();
-  tool_on_surface_ = resting;
-}
-
-void Controller::restart_wall_feel() {
   stretch_rate_.reset();
   handle_velocity_.reset();
   speed_predictor_.reset();
@@ -610,6 +602,10 @@ void Controller::restart_wall_feel() {
   have_last_handle_ = false;
   was_penetrating_ = false;
   force_before_.setZero();
+}
+
+void Controller::restart_wall_feel() {
+  restart_feel_estimates();
   tool_on_surface_ = false;
 }
 

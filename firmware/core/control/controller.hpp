@@ -182,7 +182,7 @@ class Controller {
   [[nodiscard]] Eigen::Vector3d speed_penalty();
   // The estimates start again (after any cycle that rendered no force): no stale velocity, no old balance.
   void restart_wall_feel();
-  // A change of the feel's parameters: the estimates start again, a resting tool stays held.
+  // The estimates alone (a change of the feel's parameters): a resting tool stays held.
   void restart_feel_estimates();
   [[nodiscard]] JournalRecord build_journal_record(hal::MonotonicNs now_ns) const;
   [[nodiscard]] Telemetry build_telemetry(hal::MonotonicNs now_ns, hal::MonotonicNs deadline_ns,
