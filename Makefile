@@ -10,7 +10,7 @@ help:
 	@echo "make test-asan  the same under AddressSanitizer + UndefinedBehaviorSanitizer (build/asan)"
 	@echo "make test-debug the same without optimisation (build/debug)"
 	@echo "make build      build only (binaries in build/bin)"
-	@echo "make bench      time the engine (query, full cycle) beside brute force and FCL: build/bin/stencil-bench"
+	@echo "make bench      time the engine (query, full cycle) beside brute force, FCL and the previous engine (1f546f3), with callgrind's instruction counts: build/bin/stencil-bench"
 	@echo "make rt         build for the real-time x86-64 box (build/rt-x86_64)"
 	@echo "make latency    the cycle's wake-up latency beside cyclictest's, under stress-ng (LATENCY_SECONDS=60 per phase)"
 	@echo "make soak       a simulated SOAK_HOURS (8) job with SOAK_FAULTS (12) random faults, resumed after each (build/soak)"
@@ -41,7 +41,10 @@ test: build
 e2e: build
 	ctest --preset release -L e2e
 
+# The previous engine (commit 1f546f3) is built beside this one for the bench's "previous" rows;
+# without the repository's history the bench runs without them.
 bench: build
+	bash toolchain/bench-previous.sh || true
 	build/bin/stencil-bench
 
 # The main job: the host simulation on the baked-in sample part, a raster job until every reachable

@@ -42,6 +42,7 @@ packages=(
   nlohmann-json3-dev # --inspect --json
   libpng-dev         # stencil-sim's picture of the machined stock (PNG)
   libfcl-dev         # stencil-bench compares the engine with the Flexible Collision Library
+  valgrind           # stencil-bench counts one query's instructions and L1 misses (callgrind, its client header)
   clang              # the fuzz preset's compiler (libFuzzer needs clang)
   libclang-rt-14-dev # libFuzzer and the sanitizer runtimes for clang 14 (only recommended by clang)
   clang-tidy         # make size-check: readability-function-size over the programs, runtime and boards

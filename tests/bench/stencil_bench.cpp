@@ -1,14 +1,31 @@
 // stencil-bench: time of the collision query and of the full cycle (query + remediation with its
 // sweep) on finely tessellated parts of 1e4, 1e5 and 1e6 points, in free space, in light and deep
-// contact, beside brute force (every point through the tool BSP) and FCL on the same data.
+// contact, beside brute force (every point through the tool BSP) and FCL on the same data, and
+// beside the engine of commit 1f546f3 (rows "previous"), with each query's instruction count from
+// callgrind, so that a speed-up is a ratio from one run and a count no machine's noise moves.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
+#include <valgrind/callgrind.h>
+
+// STENCIL_BENCH_PREVIOUS: this file compiled against the engine of commit 1f546f3
+// (toolchain/bench-previous.sh), whose headers lived elsewhere and which had no wall's feel.
+#if defined(STENCIL_BENCH_PREVIOUS)
+#include "firmware/stencil/contact_query.hpp"
+#include "firmware/stencil/virtual_tool.hpp"
+#include "firmware/tables/table_loader.hpp"
+#else
 #include "board/sherline_suzuki/rig_facts.hpp"
 #include "firmware/core/stencil/contact_query.hpp"
 #include "firmware/core/stencil/haptic_force.hpp"
@@ -18,6 +35,7 @@
 #include "firmware/core/stencil/velocity_filter.hpp"
 #include "firmware/core/stencil/virtual_tool.hpp"
 #include "firmware/core/tables/table_loader.hpp"
+#endif
 #include "tests/bench/fcl_reference.hpp"
 #include "toolchain/tablegen/sample_parts.hpp"
 #include "toolchain/tablegen/table_generator.hpp"
@@ -32,6 +50,7 @@ using Clock = std::chrono::steady_clock;
 // lower level at z = 3 for x < 25 and an upper level at z = 6 beyond, so it has flat faces and a
 // concave corner where the lower level meets the step.
 constexpr double kLow = 3.0, kHigh = 6.0, kStepX = 25.0;
+constexpr double kToolRadius = 1.5;  // the bench's tool: ball:d=3
 
 std::vector<tablegen::Facet> stepped_field(std::size_t triangles) {
   const double width = 40.0, depth = 20.0, x0 = 5.0, y0 = 2.5;
@@ -118,170 +137,540 @@ Timing baseline_of_length(double median_us) {
   return measure([&] { chain(steps); }, 5000, 2.0);
 }
 
-}  // namespace
 
-int main(int argc, char** argv) {
+struct Options {
   bool json = false;
   bool references = true;
-  std::string only_state;  // empty: every state
+  bool previous = true;      // the "previous" rows, from the engine of commit 1f546f3
+  bool instructions = true;  // each query's instructions and L1 misses under callgrind
+  bool tablegen = true;      // the table generator's time on a million-triangle part, both engines
+  std::string only_state;    // empty: every state
   std::vector<std::size_t> sizes = {10'000, 100'000, 1'000'000};
-  for (int i = 1; i < argc; ++i) {
-    const std::string argument = argv[i];
-    if (argument == "--json") {
-      json = true;
-    } else if (argument == "--quick") {
-      sizes = {10'000, 100'000};
-    } else if (argument == "--large") {
-      sizes = {1'000'000};
-    } else if (argument == "--stencil-only") {
-      references = false;
-    } else if (argument == "--state" && i + 1 < argc) {
-      only_state = argv[++i];
-      if (only_state != "free" && only_state != "light" && only_state != "deep" && only_state != "deep-corner") {
-        std::fprintf(stderr, "stencil-bench: --state %s: expected free, light, deep or deep-corner\n", only_state.c_str());
-        return 2;
-      }
-    } else {
-      std::printf(
-          "usage: stencil-bench [--json] [--quick | --large] [--stencil-only] [--state NAME]\n"
-          "Times the collision query and the full cycle (query + remediation with sweep) on parts of\n"
-          "1e4, 1e5 and 1e6 points (--quick: the first two) in free space, light contact (0.05 mm into a\n"
-          "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
-          "FCL. --large: only 1e6 points. --stencil-only: leave out brute force and FCL (for profiling).\n"
-          "--state free|light|deep|deep-corner: only that state (for profiling one case).\n"
-          "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
-          "timed the same way, so the machine's own tail can be told from the code's.\n"
-          "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
-          "speed penalty), on\n"
-          "its longest path (the probe under a resting tool and the query at the friction's goal).\n"
-          "--json: one JSON object per line.\n");
-      return argument == "--help" || argument == "-h" ? 0 : 2;
-    }
-  }
-  if (!json) {
-    std::printf("%9s %-12s %-12s %-5s %10s %10s %10s %8s\n", "points", "state", "impl", "what", "median_us",
-                "p999_us", "max_us", "samples");
-  }
-  const double radius = 1.5;
-  const std::vector<State> states = {
+  std::string previous_path;  // the previous engine's stencil-bench
+  std::string table_path;     // --table: time (or count) this table instead of generating one
+  std::string write_table;    // --write-table: generate the table for --points and write it here
+  bool count_queries = false; // --count-queries: one query per state under callgrind (internal)
+};
+
+const std::vector<State>& states() {
+  static const std::vector<State> all = {
       {"free", {15.0, 12.5, 9.0}, {15.0, 12.5, 9.0}},
       {"light", {15.0, 12.5, kLow - 0.05}, {15.0, 12.5, kLow + 0.001}},
       {"deep", {15.0, 12.5, kLow - 0.5}, {15.0, 12.5, kLow + 0.001}},
-      {"deep-corner", {kStepX - radius + 0.5, 12.5, kLow - 0.5}, {kStepX - radius - 0.3, 12.5, kLow + 0.001}},
+      {"deep-corner", {kStepX - kToolRadius + 0.5, 12.5, kLow - 0.5}, {kStepX - kToolRadius - 0.3, 12.5, kLow + 0.001}},
   };
+  return all;
+}
+
+// The bench part's table at about `target` points, from the table generator in memory.
+std::vector<unsigned char> bench_table(std::size_t target) {
+  // About a third as many triangles as points; the rest of the points seeded on the surface.
+  const std::vector<tablegen::Facet> facets = stepped_field(target / 3);
+  tablegen::GeneratorOptions options;
+#if !defined(STENCIL_BENCH_PREVIOUS)  // then the generator's default workspace was this one
+  const auto& workspace = board::sherline_suzuki::kRig.workspace_mm;  // the rig's, as stencil-tablegen's
+  options.placement.workspace_mm = {workspace[0], workspace[1], workspace[2]};
+#endif
+  options.tool = tablegen::parse_tool("ball:d=3", "");
+  options.spacing_mm = 50.0;  // fine triangles: vertices and centroids, no subdivision
+  options.force = true;
+  options.extra_points = target - std::min<std::size_t>(target, facets.size() * 3 / 2);
+  options.threads = 2;
+  tablegen::GeneratorReport report;
+  tablegen::TableContents contents = tablegen::generate_tables(tablegen::encode_stl(facets, true, "bench"),
+                                                               "bench.stl", options, report, [](const char*, double) {});
+  const tablegen::TableBytes bytes = tablegen::assemble_table(contents);
+  const auto* first = reinterpret_cast<const unsigned char*>(bytes.data());
+  return {first, first + bytes.size()};
+}
+
+bool read_file(const std::string& path, std::vector<unsigned char>& bytes) {
+  std::FILE* in = std::fopen(path.c_str(), "rb");
+  if (in == nullptr) {
+    return false;
+  }
+  bytes.clear();
+  unsigned char block[65536];
+  for (std::size_t n = std::fread(block, 1, sizeof block, in); n > 0; n = std::fread(block, 1, sizeof block, in)) {
+    bytes.insert(bytes.end(), block, block + n);
+  }
+  const bool whole = std::ferror(in) == 0;
+  std::fclose(in);
+  return whole;
+}
+
+bool write_file(const std::string& path, const std::vector<unsigned char>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  return static_cast<bool>(out);
+}
+
+// Under callgrind (--instr-atstart=no --collect-atstart=no): one query of `state` after one
+// uncounted query at the same pose (code and data as warm as in the cycle, which queries next to
+// where it queried a millisecond before), counted alone.
+int count_one_query(const tables::PartTables& part, const std::string& state_name) {
+  const State* state = nullptr;
+  for (const State& s : states()) {
+    state = s.name == state_name ? &s : state;
+  }
+  if (state == nullptr || RUNNING_ON_VALGRIND == 0) {
+    std::fprintf(stderr, "stencil-bench: --count-queries needs --state and callgrind\n");
+    return 2;
+  }
+  const engine::ToolPose pose{state->desired, Eigen::Vector3d::UnitZ()};
+  const engine::ContactParameters parameters{};
+  CALLGRIND_START_INSTRUMENTATION;
+  sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm;
+  CALLGRIND_TOGGLE_COLLECT;
+  const engine::ContactResult counted = engine::query_contacts(part, pose, parameters);
+  CALLGRIND_TOGGLE_COLLECT;
+  CALLGRIND_STOP_INSTRUMENTATION;
+  std::printf("%u\n", counted.penetrating_points);
+  return 0;
+}
+
+std::string shell_quoted(const std::string& text) {
+  std::string out = "'";
+  for (const char c : text) {
+    out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  }
+  return out + "'";
+}
+
+// One query's instructions and L1 misses (instruction fetch plus data read and write), counted by
+// callgrind's cache simulation: the same on any machine for the same binary and table.
+struct QueryCount {
+  bool ok = false;
+  std::uint64_t instructions = 0;
+  std::uint64_t l1_misses = 0;
+};
+
+QueryCount count_query(const std::string& bench, const std::string& table, const std::string& state,
+                       const std::string& scratch) {
+  const std::string out = scratch + "/callgrind." + state;
+  const std::string command = "valgrind --tool=callgrind --cache-sim=yes --instr-atstart=no --collect-atstart=no "
+                              "--callgrind-out-file=" + shell_quoted(out) + " " + shell_quoted(bench) + " --count-queries --table " +
+                              shell_quoted(table) + " --state " + state + " > /dev/null 2>&1";
+  QueryCount count;
+  if (std::system(command.c_str()) != 0) {
+    return count;
+  }
+  std::ifstream in(out);
+  std::vector<std::string> events;
+  for (std::string line; std::getline(in, line);) {
+    std::istringstream words(line);
+    std::string key;
+    words >> key;
+    if (key == "events:") {
+      for (std::string event; words >> event;) {
+        events.push_back(event);
+      }
+    } else if (key == "totals:") {  // not "summary:", which callgrind leaves at 0 when collection starts off
+      for (std::size_t i = 0; i < events.size(); ++i) {
+        std::uint64_t value = 0;
+        words >> value;
+        count.instructions += events[i] == "Ir" ? value : 0;
+        count.l1_misses += events[i] == "I1mr" || events[i] == "D1mr" || events[i] == "D1mw" ? value : 0;
+      }
+      count.ok = !events.empty();
+      break;
+    }
+  }
+  std::filesystem::remove(out);
+  return count;
+}
+
+// Runs `command` and returns its standard output's lines (empty when it failed).
+std::vector<std::string> output_lines(const std::string& command) {
+  std::vector<std::string> lines;
+  std::FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) {
+    return lines;
+  }
+  std::string line;
+  for (int c = std::fgetc(pipe); c != EOF; c = std::fgetc(pipe)) {
+    if (c == '\n') {
+      lines.push_back(line);
+      line.clear();
+    } else {
+      line += static_cast<char>(c);
+    }
+  }
+  if (pclose(pipe) != 0) {
+    lines.clear();
+  }
+  return lines;
+}
+
+// A field of one of this bench's own JSON rows (numbers and strings without escapes).
+std::string json_field(const std::string& row, const std::string& name) {
+  const std::string key = "\"" + name + "\": ";
+  const std::size_t at = row.find(key);
+  if (at == std::string::npos) {
+    return {};
+  }
+  std::size_t begin = at + key.size();
+  std::size_t end = begin;
+  if (row[begin] == '"') {
+    end = row.find('"', ++begin);
+  } else {
+    end = row.find_first_of(",}", begin);
+  }
+  return row.substr(begin, end - begin);
+}
+
+struct Row {
+  std::uint32_t points = 0;
+  std::uint32_t triangles = 0;
+  std::string state, impl, what;
+  Timing timing{};
+  QueryCount count{};
+};
+
+void print_row(const Options& options, const Row& row) {
+  const std::string instructions = row.count.ok ? std::to_string(row.count.instructions) : "";
+  const std::string misses = row.count.ok ? std::to_string(row.count.l1_misses) : "";
+  if (options.json) {
+    const std::string counted =
+        row.count.ok ? ", \"instructions\": " + instructions + ", \"l1_misses\": " + misses : std::string();
+    std::printf(
+        "{\"points\": %u, \"triangles\": %u, \"state\": \"%s\", \"impl\": \"%s\", \"what\": \"%s\", "
+        "\"median_us\": %.3f, \"p999_us\": %.3f, \"max_us\": %.3f, \"samples\": %zu%s}\n",
+        row.points, row.triangles, row.state.c_str(), row.impl.c_str(), row.what.c_str(), row.timing.median_us,
+        row.timing.p999_us, row.timing.max_us, row.timing.samples, counted.c_str());
+  } else {
+    std::printf("%9u %-12s %-12s %-8s %10.2f %10.2f %10.2f %8zu %12s %9s\n", row.points, row.state.c_str(),
+                row.impl.c_str(), row.what.c_str(), row.timing.median_us, row.timing.p999_us, row.timing.max_us,
+                row.timing.samples, instructions.c_str(), misses.c_str());
+  }
+  std::fflush(stdout);
+}
+
+// The previous engine's rows for one state, from its own bench on its own table (same harness,
+// same machine, right after this engine's rows): its "stencil" rows, as impl "previous".
+std::vector<Row> previous_rows(const Options& options, const std::string& table, const State& state,
+                               const QueryCount& count) {
+  std::vector<Row> rows;
+  const std::string command = shell_quoted(options.previous_path) +
+                              " --json --stencil-only --no-previous --no-instructions --no-tablegen --table " +
+                              shell_quoted(table) + " --state " + state.name;
+  for (const std::string& line : output_lines(command)) {
+    if (json_field(line, "impl") != "stencil") {
+      continue;  // its baselines: this run's own are the reference
+    }
+    Row row;
+    row.points = static_cast<std::uint32_t>(std::stoul(json_field(line, "points")));
+    row.triangles = static_cast<std::uint32_t>(std::stoul(json_field(line, "triangles")));
+    row.state = state.name;
+    row.impl = "previous";
+    row.what = json_field(line, "what");
+    row.timing = {std::stod(json_field(line, "median_us")), std::stod(json_field(line, "p999_us")),
+                  std::stod(json_field(line, "max_us")), std::stoul(json_field(line, "samples"))};
+    row.count = row.what == "query" ? count : QueryCount{};
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+std::string self_path() {
+  std::error_code error;
+  const std::filesystem::path self = std::filesystem::read_symlink("/proc/self/exe", error);
+  return error ? std::string() : self.string();
+}
+
+// This engine's rows for one state: the query, the cycle and its baseline, the cycle with the
+// wall's feel and its baseline, and the references.
+void state_rows(const Options& options, const tables::PartTables& part, const bench::FclReference* fcl,
+                const State& state, const QueryCount& count) {
+  const engine::ContactParameters parameters{};
+  Row row;
+  row.points = part.point_count();
+  row.triangles = part.triangle_count();
+  row.state = state.name;
+  const auto emit = [&](const char* impl, const char* what, const Timing& timing, const QueryCount& counted) {
+    row.impl = impl;
+    row.what = what;
+    row.timing = timing;
+    row.count = counted;
+    print_row(options, row);
+  };
+  const engine::ToolPose pose{state.desired, Eigen::Vector3d::UnitZ()};
+  const Timing query =
+      measure([&] { sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm; }, 5000, 2.0);
+  emit("stencil", "query", query, count);
+  const Timing cycle = measure(
+      [&] {
+        engine::VirtualTool tool(part, state.resting);
+        const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
+        const engine::RemediationResult result = tool.step(state.desired, contact, parameters);
+        sink = sink + contact.max_depth_mm + result.tip_mm.z();
+      },
+      5000, 2.0);
+  emit("stencil", "cycle", cycle, {});
+  emit("baseline", "cycle", baseline_of_length(cycle.median_us), {});
+#if !defined(STENCIL_BENCH_PREVIOUS)
+  // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
+  // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
+  // the part slides), the probe under the resting tool and the query at the friction's goal, then
+  // the velocity filters, the damper, the passivity observer and controller, the speed penalty
+  // (its velocity predictor left out: a few multiplications), and the force.
+  const Timing felt = measure(
+      [&] {
+        engine::VirtualTool tool(part, state.resting);
+        const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
+        const engine::FrictionGoal goal = engine::friction_goal(tool.tip_mm(), state.desired, contact, 10.0, 0.05);
+        engine::RemediationResult result{};
+        bool moved = false;
+        if (goal.in_contact && contact.force_n.norm() > 0.0) {
+          const engine::ContactResult below =
+              tool.contact_at(tool.tip_mm() - 0.01 * contact.force_n.normalized(), parameters);
+          if (below.penetrating_points > 0 && !goal.sticking) {
+            result = tool.step(goal.goal_mm, tool.contact_at(goal.goal_mm, parameters), parameters);
+            moved = true;
+          }
+        }
+        if (!moved) {
+          result = tool.step(state.desired, contact, parameters);
+        }
+        engine::VelocityFilter stretch_rate, handle_velocity;
+        stretch_rate.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
+        handle_velocity.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
+        engine::PassivityController passivity;
+        const Eigen::Vector3d stretch = 1e-2 * (result.tip_mm - state.desired);
+        static_cast<void>(stretch_rate.update(stretch));
+        static_cast<void>(handle_velocity.update(1e-2 * state.desired));
+        static_cast<void>(passivity.observe(contact.force_n, 1e-5 * Eigen::Vector3d::Ones()));
+        const Eigen::Vector3d velocity = handle_velocity.update(1e-2 * state.desired + Eigen::Vector3d::Constant(1e-5));
+        const Eigen::Vector3d added = 30.0 * stretch_rate.update(stretch + Eigen::Vector3d::Constant(1e-6)) +
+                                      passivity.correction(velocity, 1e-3, 5.0) +
+                                      engine::speed_penalty_n(velocity, engine::mill_speed_along(velocity, 0.01, 0.01), 5.0);
+        const engine::HapticOutput out =
+            engine::haptic_output(state.desired, result.tip_mm, contact, engine::HapticLimits{}, added);
+        sink = sink + contact.max_depth_mm + result.tip_mm.z() + out.force_n.x();
+      },
+      5000, 2.0);
+  emit("stencil+feel", "cycle", felt, {});
+  emit("baseline", "cycle", baseline_of_length(felt.median_us), {});
+#endif
+  if (fcl == nullptr) {
+    return;
+  }
+  emit("bruteforce", "query",
+       measure([&] { sink = sink + static_cast<double>(brute_force(part, state.desired)); }, 200, 2.0), {});
+  const double tip[3] = {state.desired.x(), state.desired.y(), state.desired.z()};
+  emit("fcl", "query",
+       measure([&] { sink = sink + fcl->query(tip, true, kToolRadius, part.tool.envelope.flute_length_mm).max_depth_mm; },
+               500, 2.0),
+       {});
+}
+
+// The table generator on a million-triangle bench part, this engine's and the previous one's,
+// alternately twice each: rows with what "tablegen" (the median is the faster of the two runs).
+void tablegen_rows(const Options& options, const std::string& scratch) {
+  const std::string stl = scratch + "/million.stl";
+  const std::vector<std::byte> bytes = tablegen::encode_stl(stepped_field(1'000'000), true, "bench");
+  std::vector<unsigned char> copy(bytes.size());
+  std::memcpy(copy.data(), bytes.data(), bytes.size());
+  if (!write_file(stl, copy)) {
+    std::fprintf(stderr, "stencil-bench: cannot write %s\n", stl.c_str());
+    return;
+  }
+  const std::string here = std::filesystem::path(self_path()).parent_path().string() + "/stencil-tablegen";
+  const std::string before = std::filesystem::path(options.previous_path).parent_path().string() + "/stencil-tablegen";
+  std::vector<double> seconds[2];
+  for (int round = 0; round < 2; ++round) {
+    for (int which = 0; which < 2; ++which) {
+      const std::string command = shell_quoted(which == 0 ? here : before) + " " + shell_quoted(stl) +
+                                  " --tool ball:d=3 --spacing 50 --force --quiet -o " + shell_quoted(scratch + "/million.stbl");
+      const auto begin = Clock::now();
+      if (std::system(command.c_str()) != 0) {
+        std::fprintf(stderr, "stencil-bench: %s failed\n", command.c_str());
+        return;
+      }
+      seconds[which].push_back(std::chrono::duration<double>(Clock::now() - begin).count());
+    }
+  }
+  for (int which = 0; which < 2; ++which) {
+    const double best = std::min(seconds[which][0], seconds[which][1]);
+    Row row;
+    row.triangles = 1'000'000;
+    row.state = "-";
+    row.impl = which == 0 ? "stencil" : "previous";
+    row.what = "tablegen";
+    row.timing = {best * 1e6, std::max(seconds[which][0], seconds[which][1]) * 1e6, 0.0, 2};
+    row.timing.max_us = row.timing.p999_us;
+    print_row(options, row);
+  }
+}
+
+constexpr const char* kUsage =
+    "usage: stencil-bench [--json] [--quick | --large | --points N] [--stencil-only] [--state NAME]\n"
+    "                     [--no-previous | --previous PATH] [--no-instructions] [--no-tablegen] [--table FILE]\n"
+    "Times the collision query and the full cycle (query + remediation with sweep) on parts of\n"
+    "1e4, 1e5 and 1e6 points (--quick: the first two) in free space, light contact (0.05 mm into a\n"
+    "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
+    "FCL. --large: only 1e6 points; --points N: only about N. --stencil-only: leave out brute force\n"
+    "and FCL. --state free|light|deep|deep-corner: only that state (for profiling one case).\n"
+    "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
+    "timed the same way, so the machine's own tail can be told from the code's.\n"
+    "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
+    "speed penalty), on its longest path (the probe under a resting tool and the query at the\n"
+    "friction's goal).\n"
+    "Impl \"previous\": the same query and cycle with the engine of commit 1f546f3 (before the packed\n"
+    "leaf layout), built by toolchain/bench-previous.sh (make bench does) into build/previous/bin and\n"
+    "run on its own table of the same part right after this engine's rows; --previous PATH names\n"
+    "that bench elsewhere, --no-previous leaves the rows out.\n"
+    "Query rows carry \"instructions\" and \"l1_misses\": one query (after one uncounted query at the\n"
+    "same pose) under valgrind's callgrind with its cache simulation, the same on any machine for\n"
+    "the same binary and table (--no-instructions: leave them out).\n"
+    "What \"tablegen\": stencil-tablegen on a million-triangle bench part, this tree's and the previous\n"
+    "engine's, alternately twice each; median_us is the faster run (--no-tablegen, --quick and\n"
+    "--points leave it out).\n"
+    "--table FILE: time this table (of the bench part) instead of generating one.\n"
+    "--json: one JSON object per line.\n";
+
+// 0: parsed; otherwise the exit status (2 for a bad command line, 0 for --help).
+int parse_options(int argc, char** argv, Options& options) {
+  std::filesystem::path previous = std::filesystem::path(self_path()).parent_path() / "../previous/bin/stencil-bench";
+  options.previous_path = previous.lexically_normal().string();
+  for (int i = 1; i < argc; ++i) {
+    const std::string argument = argv[i];
+    const bool has_value = i + 1 < argc;
+    if (argument == "--json") {
+      options.json = true;
+    } else if (argument == "--quick") {
+      options.sizes = {10'000, 100'000};
+      options.tablegen = false;
+    } else if (argument == "--large") {
+      options.sizes = {1'000'000};
+    } else if (argument == "--points" && has_value) {
+      char* end = nullptr;
+      const unsigned long long points = std::strtoull(argv[++i], &end, 10);
+      if (*end != '\0' || points < 100 || points > 4'000'000) {
+        std::fprintf(stderr, "stencil-bench: --points %s: expected a whole number from 100 to 4000000\n", argv[i]);
+        return 2;
+      }
+      options.sizes = {static_cast<std::size_t>(points)};
+      options.tablegen = false;
+    } else if (argument == "--stencil-only") {
+      options.references = false;
+    } else if (argument == "--no-previous") {
+      options.previous = false;
+    } else if (argument == "--previous" && has_value) {
+      options.previous_path = argv[++i];
+    } else if (argument == "--no-instructions") {
+      options.instructions = false;
+    } else if (argument == "--no-tablegen") {
+      options.tablegen = false;
+    } else if (argument == "--table" && has_value) {
+      options.table_path = argv[++i];
+    } else if (argument == "--write-table" && has_value) {
+      options.write_table = argv[++i];
+    } else if (argument == "--count-queries") {
+      options.count_queries = true;
+    } else if (argument == "--state" && has_value) {
+      options.only_state = argv[++i];
+      if (options.only_state != "free" && options.only_state != "light" && options.only_state != "deep" &&
+          options.only_state != "deep-corner") {
+        std::fprintf(stderr, "stencil-bench: --state %s: expected free, light, deep or deep-corner\n", argv[i]);
+        return 2;
+      }
+    } else {
+      std::printf("%s", kUsage);
+      return argument == "--help" || argument == "-h" ? -1 : 2;
+    }
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options options;
+  if (const int parsed = parse_options(argc, argv, options); parsed != 0) {
+    return parsed < 0 ? 0 : parsed;
+  }
+  if (!options.write_table.empty()) {
+    return write_file(options.write_table, bench_table(options.sizes.front())) ? 0 : 1;
+  }
+  if (options.previous && (options.table_path.size() > 0 || !std::filesystem::exists(options.previous_path))) {
+    if (options.table_path.empty()) {
+      std::fprintf(stderr, "stencil-bench: no previous engine at %s (toolchain/bench-previous.sh builds it): "
+                   "no \"previous\" rows\n", options.previous_path.c_str());
+    }
+    options.previous = false;
+  }
+  if (options.instructions && !options.count_queries && std::system("valgrind --version > /dev/null 2>&1") != 0) {
+    std::fprintf(stderr, "stencil-bench: valgrind is not installed (toolchain/install-deps.sh): no instruction counts\n");
+    options.instructions = false;
+  }
+  const std::string scratch =
+      (std::filesystem::temp_directory_path() / ("stencil-bench." + std::to_string(getpid()))).string();
+  std::filesystem::create_directories(scratch);
+  struct Remove {
+    std::string path;
+    ~Remove() { std::filesystem::remove_all(path); }
+  } const remove_scratch{scratch};
+  if (!options.json && !options.count_queries) {
+    std::printf("%9s %-12s %-12s %-8s %10s %10s %10s %8s %12s %9s\n", "points", "state", "impl", "what", "median_us",
+                "p999_us", "max_us", "samples", "instructions", "l1_misses");
+  }
+  int status = 0;
+  const std::vector<std::size_t> sizes = options.table_path.empty() ? options.sizes : std::vector<std::size_t>{0};
   for (const std::size_t target : sizes) {
-    // About a third as many triangles as points; the rest of the points seeded on the surface.
-    const std::vector<tablegen::Facet> facets = stepped_field(target / 3);
-    tablegen::GeneratorOptions options;
-    const auto& workspace = board::sherline_suzuki::kRig.workspace_mm;  // the rig's, as stencil-tablegen's
-    options.placement.workspace_mm = {workspace[0], workspace[1], workspace[2]};
-    options.tool = tablegen::parse_tool("ball:d=3", "");
-    options.spacing_mm = 50.0;  // fine triangles: vertices and centroids, no subdivision
-    options.force = true;
-    options.extra_points = target - std::min<std::size_t>(target, facets.size() * 3 / 2);
-    options.threads = 2;
-    tablegen::GeneratorReport report;
-    tablegen::TableContents contents = tablegen::generate_tables(tablegen::encode_stl(facets, true, "bench"),
-                                                                 "bench.stl", options, report, [](const char*, double) {});
-    const tablegen::TableBytes bytes = tablegen::assemble_table(contents);
+    std::vector<unsigned char> bytes;
+    const std::string table = options.table_path.empty() ? scratch + "/stencil.stbl" : options.table_path;
+    if (options.table_path.empty()) {
+      bytes = bench_table(target);
+      write_file(table, bytes);
+    } else if (!read_file(table, bytes)) {
+      std::fprintf(stderr, "stencil-bench: %s: cannot be read\n", table.c_str());
+      return 1;
+    }
     tables::PartTables part{};
-    const tables::TableLoadResult loaded = tables::load_tables({bytes.data(), bytes.size()}, part);
+    const tables::TableLoadResult loaded =
+        tables::load_tables({reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()}, part);
     if (!loaded.ok) {
       std::fprintf(stderr, "stencil-bench: the bench table did not load: %s\n", loaded.field);
       return 1;
     }
+    if (options.count_queries) {
+      return count_one_query(part, options.only_state);
+    }
+    const std::string previous_table = scratch + "/previous.stbl";
+    if (options.previous &&
+        std::system((shell_quoted(options.previous_path) + " --points " + std::to_string(target) + " --write-table " +
+                     shell_quoted(previous_table)).c_str()) != 0) {
+      std::fprintf(stderr, "stencil-bench: %s could not write its table: no \"previous\" rows\n",
+                   options.previous_path.c_str());
+      options.previous = false;
+    }
     std::vector<float> triangles(9 * part.triangle_count());
     std::memcpy(triangles.data(), part.triangles, triangles.size() * sizeof(float));
     const bench::FclReference fcl(triangles.data(), part.triangle_count());
-    const engine::ContactParameters parameters{};
-
-    const auto report_row = [&](const State& state, const char* impl, const char* what, const Timing& t) {
-      if (json) {
-        std::printf(
-            "{\"points\": %u, \"triangles\": %u, \"state\": \"%s\", \"impl\": \"%s\", \"what\": \"%s\", "
-            "\"median_us\": %.3f, \"p999_us\": %.3f, \"max_us\": %.3f, \"samples\": %zu}\n",
-            part.point_count(), part.triangle_count(), state.name, impl, what, t.median_us, t.p999_us, t.max_us,
-            t.samples);
-      } else {
-        std::printf("%9u %-12s %-12s %-5s %10.2f %10.2f %10.2f %8zu\n", part.point_count(), state.name, impl, what,
-                    t.median_us, t.p999_us, t.max_us, t.samples);
-      }
-      std::fflush(stdout);
-    };
-
-    for (const State& state : states) {
-      if (!only_state.empty() && only_state != state.name) {
+    for (const State& state : states()) {
+      if (!options.only_state.empty() && options.only_state != state.name) {
         continue;
       }
-      const engine::ToolPose pose{state.desired, Eigen::Vector3d::UnitZ()};
-      const Timing query = measure([&] { sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm; },
-                                   5000, 2.0);
-      report_row(state, "stencil", "query", query);
-      const Timing cycle = measure(
-          [&] {
-            engine::VirtualTool tool(part, state.resting);
-            const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
-            const engine::RemediationResult result = tool.step(state.desired, contact, parameters);
-            sink = sink + contact.max_depth_mm + result.tip_mm.z();
-          },
-          5000, 2.0);
-      report_row(state, "stencil", "cycle", cycle);
-      report_row(state, "baseline", "cycle", baseline_of_length(cycle.median_us));
-      // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
-      // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
-      // the part slides), the probe under the resting tool and the query at the friction's goal, then
-      // the velocity filters, the damper, the passivity observer and controller, the speed penalty
-      // (its velocity predictor left out: a few multiplications), and the force.
-      const Timing felt = measure(
-          [&] {
-            engine::VirtualTool tool(part, state.resting);
-            const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
-            const engine::FrictionGoal goal = engine::friction_goal(tool.tip_mm(), state.desired, contact, 10.0, 0.05);
-            engine::RemediationResult result{};
-            bool moved = false;
-            if (goal.in_contact && contact.force_n.norm() > 0.0) {
-              const engine::ContactResult below =
-                  tool.contact_at(tool.tip_mm() - 0.01 * contact.force_n.normalized(), parameters);
-              if (below.penetrating_points > 0 && !goal.sticking) {
-                result = tool.step(goal.goal_mm, tool.contact_at(goal.goal_mm, parameters), parameters);
-                moved = true;
-              }
-            }
-            if (!moved) {
-              result = tool.step(state.desired, contact, parameters);
-            }
-            engine::VelocityFilter stretch_rate, handle_velocity;
-            stretch_rate.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
-            handle_velocity.configure(engine::VelocityFilter::kDefaultCutoffHz, 1e-3);
-            engine::PassivityController passivity;
-            const Eigen::Vector3d stretch = 1e-2 * (result.tip_mm - state.desired);
-            static_cast<void>(stretch_rate.update(stretch));
-            static_cast<void>(handle_velocity.update(1e-2 * state.desired));
-            static_cast<void>(passivity.observe(contact.force_n, 1e-5 * Eigen::Vector3d::Ones()));
-            const Eigen::Vector3d velocity =
-                handle_velocity.update(1e-2 * state.desired + Eigen::Vector3d::Constant(1e-5));
-            const Eigen::Vector3d added = 30.0 * stretch_rate.update(stretch + Eigen::Vector3d::Constant(1e-6)) +
-                                          passivity.correction(velocity, 1e-3, 5.0) +
-                                          engine::speed_penalty_n(velocity, engine::mill_speed_along(velocity, 0.01, 0.01), 5.0);
-            const engine::HapticOutput out =
-                engine::haptic_output(state.desired, result.tip_mm, contact, engine::HapticLimits{}, added);
-            sink = sink + contact.max_depth_mm + result.tip_mm.z() + out.force_n.x();
-          },
-          5000, 2.0);
-      report_row(state, "stencil+feel", "cycle", felt);
-      report_row(state, "baseline", "cycle", baseline_of_length(felt.median_us));
-      if (!references) {
-        continue;
+      const std::string self = self_path();
+      const QueryCount count = options.instructions ? count_query(self, table, state.name, scratch) : QueryCount{};
+      state_rows(options, part, options.references ? &fcl : nullptr, state, count);
+      if (options.previous) {
+        const QueryCount before =
+            options.instructions ? count_query(options.previous_path, previous_table, state.name, scratch) : QueryCount{};
+        const std::vector<Row> rows = previous_rows(options, previous_table, state, before);
+        if (rows.empty()) {
+          std::fprintf(stderr, "stencil-bench: the previous engine's bench gave no rows for %s\n", state.name);
+          status = 1;
+        }
+        for (const Row& row : rows) {
+          print_row(options, row);
+        }
       }
-      const Timing brute = measure([&] { sink = sink + static_cast<double>(brute_force(part, state.desired)); },
-                                   200, 2.0);
-      report_row(state, "bruteforce", "query", brute);
-      const double tip[3] = {state.desired.x(), state.desired.y(), state.desired.z()};
-      const Timing reference = measure(
-          [&] { sink = sink + fcl.query(tip, true, radius, part.tool.envelope.flute_length_mm).max_depth_mm; }, 500,
-          2.0);
-      report_row(state, "fcl", "query", reference);
     }
   }
-  return 0;
+  if (options.tablegen && options.previous) {
+    tablegen_rows(options, scratch);
+  }
+  return status;
 }
