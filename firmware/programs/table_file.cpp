@@ -1,11 +1,25 @@
 #include "firmware/programs/table_file.hpp"
 
 #include <cstddef>
+#include <cstdint>
 #include <cstdio>
+#include <sstream>
 
 #include "firmware/core/tables/table_loader.hpp"
 
 namespace stencil::app {
+
+std::string describe_refusal(const tables::TableLoadResult& refused) {
+  if (refused.expected == tables::kOlderVersion) {
+    return "format version " + std::to_string(static_cast<std::uint64_t>(refused.value)) +
+           ": regenerate with stencil-tablegen (this build reads format version " +
+           std::to_string(tables::kTableFormatVersion) + ")";
+  }
+  std::ostringstream text;
+  text << "not a valid table: " << refused.field << " (at " << refused.index << "): expected " << refused.expected
+       << ", found " << refused.value;
+  return text.str();
+}
 
 bool load_table_file(const std::string& path, std::vector<unsigned char>& bytes, tables::PartTables& part,
                      std::string& error) {
@@ -28,7 +42,7 @@ bool load_table_file(const std::string& path, std::vector<unsigned char>& bytes,
   const tables::TableLoadResult loaded =
       tables::load_tables({reinterpret_cast<const std::byte*>(bytes.data()), bytes.size()}, part);
   if (!loaded.ok) {
-    error = path + ": not a valid table: " + loaded.field;
+    error = path + ": " + describe_refusal(loaded);
   }
   return loaded.ok;
 }

@@ -5,8 +5,13 @@
 #include <vector>
 
 #include "firmware/core/tables/part_tables.hpp"
+#include "firmware/core/tables/table_loader.hpp"
 
 namespace stencil::app {
+
+// A loader's refusal in words: "format version N: regenerate with stencil-tablegen" for a table of
+// an older format, else the field, where, what was expected and what was found.
+[[nodiscard]] std::string describe_refusal(const tables::TableLoadResult& refused);
 
 // Reads `path` into `bytes` (which `part` then points into) and loads it. False with `error`
 // naming the file and, for a bad table, the field.

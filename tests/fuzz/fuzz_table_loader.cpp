@@ -42,7 +42,7 @@ void walk(const stencil::tables::PartTables& tables) {
   double sum = 0.0;
   std::uint64_t bits = 0;
   for (std::uint32_t i = 0; i < tables.point_count(); ++i) {
-    sum += coordinate_sum(tables.points[i]) + coordinate_sum(tables.normals[i]);
+    sum += coordinate_sum(tables.points[i]);
     require(tables.triangle_ids[i] < tables.triangle_count());
     bits += tables.point_flags[i];
   }
@@ -59,10 +59,20 @@ void walk(const stencil::tables::PartTables& tables) {
     }
     if (node.point_count > 0) {
       require(node.first_point < tables.point_count() && node.point_count <= tables.point_count() - node.first_point);
+      require(node.leaf < tables.leaf_count());
+      const LeafBlock& block = tables.leaves[node.leaf];
+      require(block.first_point == node.first_point && block.point_count == node.point_count);
     } else {
       require(node.right_child > i && node.right_child < tables.node_count());
     }
-    bits += node.reserved;
+    bits += node.leaf;
+  }
+  for (std::uint32_t i = 0; i < tables.leaf_count(); ++i) {
+    const LeafBlock& block = tables.leaves[i];
+    for (std::uint32_t lane = 0; lane < kMaxLeafPoints; ++lane) {
+      sum += static_cast<double>(block.x_mm[lane]) + static_cast<double>(block.nz[lane]);
+    }
+    sum += static_cast<double>(block.radius_mm);
   }
   // Keeps the reads from being optimised away.
   volatile double sink_sum = sum;

@@ -1,7 +1,9 @@
 // A part's table file read whole and checked by the firmware's loader (firmware/programs/table_file):
 // a good table loads with the part pointing into the bytes read; a missing file, a directory and a
-// file that is not a table are refused naming the file (and, for a bad table, the field).
+// file that is not a table are refused naming the file (and, for a bad table, the field, what was
+// expected and what was found); a table of the older format is to be regenerated, in those words.
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -66,4 +68,39 @@ TEST(TableFile, AFileThatIsNotATableNamesTheField) {
   CHECK_FALSE(app::load_table_file(file.path, bytes, part, error));
   STRCMP_CONTAINS((file.path + ": not a valid table: ").c_str(), error.c_str());
   CHECK(error.size() > file.path.size() + std::string(": not a valid table: ").size());
+}
+
+TEST(TableFile, ATableOfTheOlderFormatIsToBeRegenerated) {
+  tablegen::TableBytes table = test::make_table(test::default_part(), test::default_job_options(1));
+  tables::TableHeader header;
+  std::memcpy(&header, table.data(), sizeof header);
+  header.format_version = 1;  // before the packed leaves
+  std::memcpy(table.data(), &header, sizeof header);
+  header.crc32 = tables::table_crc32({table.data(), table.size()});
+  std::memcpy(table.data(), &header, sizeof header);
+  const TempFile file;
+  file.write(table.data(), table.size());
+  std::vector<unsigned char> bytes;
+  tables::PartTables part{};
+  std::string error;
+  CHECK_FALSE(app::load_table_file(file.path, bytes, part, error));
+  STRCMP_EQUAL((file.path + ": format version 1: regenerate with stencil-tablegen (this build reads format version 2)").c_str(),
+               error.c_str());
+}
+
+TEST(TableFile, ABadTableSaysWhatWasExpectedAndFound) {
+  tablegen::TableBytes table = test::make_table(test::default_part(), test::default_job_options(1));
+  tables::TableHeader header;
+  std::memcpy(&header, table.data(), sizeof header);
+  header.flags = 7;
+  std::memcpy(table.data(), &header, sizeof header);
+  header.crc32 = tables::table_crc32({table.data(), table.size()});
+  std::memcpy(table.data(), &header, sizeof header);
+  const TempFile file;
+  file.write(table.data(), table.size());
+  std::vector<unsigned char> bytes;
+  tables::PartTables part{};
+  std::string error;
+  CHECK_FALSE(app::load_table_file(file.path, bytes, part, error));
+  STRCMP_EQUAL((file.path + ": not a valid table: header.flags (at 20): expected 0, found 7").c_str(), error.c_str());
 }

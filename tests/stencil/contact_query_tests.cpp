@@ -193,7 +193,8 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       const Eigen::Vector3d inflated_tip = tip - kTolerance * Eigen::Vector3d::UnitZ();
       for (std::uint32_t i = 0; i < part.point_count(); ++i) {
         const Eigen::Vector3d p(part.points[i].x_mm, part.points[i].y_mm, part.points[i].z_mm);
-        const Eigen::Vector3d n(part.normals[i].x_mm, part.normals[i].y_mm, part.normals[i].z_mm);
+        const tables::PackedPoint normal = tables::point_normal(part, i);
+        const Eigen::Vector3d n(normal.x_mm, normal.y_mm, normal.z_mm);
         if (geometry::classify_at_pose(contact_tool, inflated_tip, Eigen::Vector3d::UnitZ(), p).contact !=
             geometry::PointContact::Outside) {
           expected_touched.insert(part.triangle_ids[i]);

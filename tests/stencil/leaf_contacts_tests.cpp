@@ -51,7 +51,24 @@ struct LeafPoints {
       normals[i] = {static_cast<float>(normal.x()), static_cast<float>(normal.y()), static_cast<float>(normal.z())};
     }
     part.points = points.data();
-    part.normals = normals.data();
+  }
+
+  // The leaf's block as the table generator packs it, from the points and normals as they are now
+  // (lanes past count repeat the last point; no sphere: load_leaf does not read it).
+  [[nodiscard]] tables::LeafBlock packed() const {
+    tables::LeafBlock block{};
+    block.first_point = 0;
+    block.point_count = count;
+    for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
+      const std::uint32_t i = std::min(lane, count - 1);
+      block.x_mm[lane] = points[i].x_mm;
+      block.y_mm[lane] = points[i].y_mm;
+      block.z_mm[lane] = points[i].z_mm;
+      block.nx[lane] = normals[i].x_mm;
+      block.ny[lane] = normals[i].y_mm;
+      block.nz[lane] = normals[i].z_mm;
+    }
+    return block;
   }
 
   [[nodiscard]] Eigen::Vector3d point(std::uint32_t i) const {
@@ -134,7 +151,7 @@ TEST_GROUP(LeafContacts) {
   void check_leaf(const LeafPoints& points, geometry::BoxCover expected_cover) {
     const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
     CHECK(cover.cover == expected_cover);
-    load_leaf(points.part, 0, points.count, kTip, leaf);
+    load_leaf(points.part, points.packed(), kTip, leaf);
     CHECK(settle(tool, cover, leaf));
     const std::uint32_t penetrating = check_against_the_tree(tool, points, leaf);
     CHECK(penetrating > 0);
@@ -164,7 +181,7 @@ void check_loaded(const LeafPoints& points, const Eigen::Vector3d& tip, const Le
 
 TEST(LeafContacts, TheLanesHoldEachPointsOffsetFromTheTipAndRepeatTheLastPastTheEnd) {
   const LeafPoints points(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d(0.2, 0.2, 0.2), 5);
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   check_loaded(points, kTip, leaf);
 }
 
@@ -175,7 +192,7 @@ TEST(LeafContacts, TheLanesHoldEachPointsOffsetFromTheTipAndRepeatTheLastPastThe
 TEST(LeafContacts, AnOffsetFromATipThatIsNotAFloatIsRightToARoundingOfItsOwnSize) {
   const Eigen::Vector3d tip(123.456789, 78.9012345, 10.0625);
   const LeafPoints points(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d(0.2, 0.2, 0.2), 5, tip);
-  load_leaf(points.part, 0, points.count, tip, leaf);
+  load_leaf(points.part, points.packed(), tip, leaf);
   check_loaded(points, tip, leaf);
 }
 
@@ -198,7 +215,7 @@ TEST(LeafContacts, ALeafAcrossThePlaneBetweenBallAndFlutesTakesEachSidesSurface)
 
 TEST(LeafContacts, ALeafAcrossSeveralOfTheTreesTestsIsSettledPointByPoint) {
   const LeafPoints points(Eigen::Vector3d(0.8, 0.0, 1.2), Eigen::Vector3d(1.0, 1.0, 1.0), 32);
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK(mixed_leaf_contacts(tool, leaf));
   const std::uint32_t penetrating = check_against_the_tree(tool, points, leaf);
   CHECK(penetrating > 0);
@@ -220,7 +237,8 @@ TEST(LeafContacts, TheDeepestOfPointsTheFloatsCannotTellApartIsFoundInDoublePrec
     const Eigen::Vector3d p = kTip + Eigen::Vector3d(0.25 + 0.15 * std::sin(1.3 * t), 0.15 + 0.15 * std::cos(0.7 * t),
                                                      0.65 + 0.15 * std::sin(2.9 * t));
     pair.points[0] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
-    load_leaf(pair.part, 0, 1, kTip, leaf);
+    pair.count = 1;
+    load_leaf(pair.part, pair.packed(), kTip, leaf);
     CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
     const auto [at, added] = seen.emplace(leaf.depth[0], std::make_pair(pair.points[0], leaf.max_depth_mm));
     if (!added && at->second.second < leaf.max_depth_mm) {
@@ -232,17 +250,20 @@ TEST(LeafContacts, TheDeepestOfPointsTheFloatsCannotTellApartIsFoundInDoublePrec
   CHECK_TEXT(found, "no two points with the same float depth among the candidates");
   pair.points[0] = first;
   pair.points[1] = second;
-  load_leaf(pair.part, 0, 2, kTip, leaf);
+  pair.count = 2;
+  load_leaf(pair.part, pair.packed(), kTip, leaf);
   CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
   DOUBLES_EQUAL(double{leaf.depth[0]}, double{leaf.depth[1]}, 0.0);
   check_against_the_tree(tool, pair, leaf);  // the deepest lane and depth: the double-precision ones
   std::swap(pair.points[0], pair.points[1]);
-  load_leaf(pair.part, 0, 2, kTip, leaf);
+  pair.count = 2;
+  load_leaf(pair.part, pair.packed(), kTip, leaf);
   CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
   check_against_the_tree(tool, pair, leaf);
   // A true tie: the first lane at the deepest depth.
   pair.points[1] = pair.points[0];
-  load_leaf(pair.part, 0, 2, kTip, leaf);
+  pair.count = 2;
+  load_leaf(pair.part, pair.packed(), kTip, leaf);
   CHECK(region_leaf_contacts(tool, cover.region, false, leaf));
   LONGS_EQUAL(0, leaf.deepest_lane);
 }
@@ -253,17 +274,17 @@ TEST(LeafContacts, ADamagedToolTreeIsAFaultNotANumber) {
   CHECK(cover.cover == geometry::BoxCover::Region);
   geometry::ToolBsp damaged = tool;
   damaged.surfaces[damaged.regions[cover.region].surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK_FALSE(region_leaf_contacts(damaged, cover.region, false, leaf));
   geometry::ToolBsp broken = tool;
   broken.node_count = 0;  // no root: every walk is a bad tree
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK_FALSE(mixed_leaf_contacts(broken, leaf));
 }
 
 TEST(LeafContacts, TheForceSumsAreEachPenetratingPointsDepthAlongItsNormalLessItsEscape) {
   const LeafPoints points(Eigen::Vector3d(0.8, 0.0, 1.2), Eigen::Vector3d(1.0, 1.0, 1.0), 32);
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK(mixed_leaf_contacts(tool, leaf));
   const double k = 10.0;
   const double height = 7.5;
@@ -290,7 +311,7 @@ TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
   LeafPoints points(Eigen::Vector3d(0.0, 0.0, 0.5), Eigen::Vector3d(0.0, 0.0, 0.0), 1);  // on the axis, 1 mm in
   // Straight below the ball's centre the escape is straight down: a normal pointing down cancels it.
   points.normals[0] = {0.0F, 0.0F, -1.0F};
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK(mixed_leaf_contacts(tool, leaf));
   LONGS_EQUAL(1, leaf.penetrating);
   const LeafForceSums none = leaf_forces(leaf, 10.0, 7.5);
@@ -298,7 +319,7 @@ TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
   CHECK(none.torque == Eigen::Vector3d::Zero());
   // Turned up, it pushes the tool up with k times the depth.
   points.normals[0] = {0.0F, 0.0F, 1.0F};
-  load_leaf(points.part, 0, points.count, kTip, leaf);
+  load_leaf(points.part, points.packed(), kTip, leaf);
   CHECK(mixed_leaf_contacts(tool, leaf));
   const LeafForceSums up = leaf_forces(leaf, 10.0, 7.5);
   DOUBLES_EQUAL(10.0 * leaf.max_depth_mm, up.force.z(), 1e-5);

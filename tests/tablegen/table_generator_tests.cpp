@@ -75,10 +75,10 @@ TEST(TableGenerator, FloorFacingFacesAreUnreachableAndTopsAreReachable) {
   Reach top;
   for (std::uint32_t i = 0; i < part.point_count(); ++i) {
     const bool reachable = (part.point_flags[i] & tables::kPointReachable) != 0;
-    if (part.normals[i].z_mm < -0.5f) {
+    if (tables::point_normal(part, i).z_mm < -0.5f) {
       down.total += 1;
       down.reachable += reachable ? 1 : 0;
-    } else if (part.normals[i].z_mm > 0.5f) {
+    } else if (tables::point_normal(part, i).z_mm > 0.5f) {
       top.total += 1;
       top.reachable += reachable ? 1 : 0;
     }
@@ -99,7 +99,7 @@ TEST(TableGenerator, ASlotNarrowerThanTheToolHasAnUnreachableFloor) {
   for (std::uint32_t i = 0; i < part.point_count(); ++i) {
     const auto& p = part.points[i];
     const bool reachable = (part.point_flags[i] & tables::kPointReachable) != 0;
-    const bool faces_up = part.normals[i].z_mm > 0.5f;
+    const bool faces_up = tables::point_normal(part, i).z_mm > 0.5f;
     if (faces_up && std::abs(p.z_mm - 3.0f) < 1e-4f && p.y_mm > 11.5f && p.y_mm < 13.5f && p.x_mm > 11.0f && p.x_mm < 39.0f) {
       slot_floor.total += 1;
       slot_floor.reachable += reachable ? 1 : 0;

@@ -134,10 +134,24 @@ TEST(TableLoader, RefusesTheWrongMagicVersionOrHeaderSize) {
 
   bytes = copy_of(valid_table(), valid_table().size());
   TableHeader header = header_of(bytes);
-  header.format_version = 2;
+  header.format_version = 3;
   put_header(bytes, header);
   reseal(bytes);
   check_refused(bytes, "header.format_version");
+
+  // A table of the format before the packed leaves: refused as older, which the programs word as
+  // "format version 1: regenerate with stencil-tablegen".
+  bytes = copy_of(valid_table(), valid_table().size());
+  header = header_of(bytes);
+  header.format_version = 1;
+  put_header(bytes, header);
+  reseal(bytes);
+  PartTables tables{};
+  const TableLoadResult older = load(bytes, tables);
+  CHECK_FALSE(older.ok);
+  STRCMP_EQUAL("header.format_version", older.field);
+  CHECK(older.expected == kOlderVersion);
+  DOUBLES_EQUAL(1.0, older.value, 0.0);
 
   bytes = copy_of(valid_table(), valid_table().size());
   header = header_of(bytes);
@@ -155,7 +169,10 @@ TEST(TableLoader, RefusesCountsBeyondCapacityOrDisagreeingWithSections) {
   with_header([](TableHeader& h) { h.point_count -= 1; }, "sections.points");
   with_header([](TableHeader& h) { h.triangle_count += 1; }, "sections.triangles");
   with_header([](TableHeader& h) { h.sections[1].offset += 8; }, "sections.points");
-  with_header([](TableHeader& h) { h.sections[2].offset = h.sections[1].offset; }, "sections.normals");
+  with_header([](TableHeader& h) { h.sections[2].offset = h.sections[1].offset; }, "sections.leaves");
+  with_header([](TableHeader& h) { h.leaf_count = 0; }, "header.leaf_count");
+  with_header([](TableHeader& h) { h.leaf_count = h.node_count + 1; }, "header.leaf_count");
+  with_header([](TableHeader& h) { h.leaf_count -= 1; }, "sections.leaves");
   with_header([](TableHeader& h) { h.sections[7].bytes = ~0ull; }, "sections.nodes");
   with_header([](TableHeader& h) { h.flags = 1; }, "header.flags");
   with_header([](TableHeader& h) { h.vertex_point_count = h.point_count + 1; }, "header.vertex_point_count");
@@ -184,14 +201,14 @@ TEST(TableLoader, RefusesBadNumbersInThePointsAndTriangles) {
   check_refused(bytes, "points");
 
   bytes = copy_of(valid_table(), valid_table().size());
-  section<PackedPoint>(bytes, TableSection::Normals)[5].x_mm = 2.0f;
+  section<LeafBlock>(bytes, TableSection::Leaves)[1].nx[5] = 2.0f;
   reseal(bytes);
-  check_refused(bytes, "normals");
+  check_refused(bytes, "leaves.normals");
 
   bytes = copy_of(valid_table(), valid_table().size());
-  section<PackedPoint>(bytes, TableSection::Normals)[5].z_mm = std::numeric_limits<float>::infinity();
+  section<LeafBlock>(bytes, TableSection::Leaves)[0].nz[5] = std::numeric_limits<float>::infinity();
   reseal(bytes);
-  check_refused(bytes, "normals");
+  check_refused(bytes, "leaves.normals");
 
   bytes = copy_of(valid_table(), valid_table().size());
   section<std::uint32_t>(bytes, TableSection::TriangleIds)[3] = 24;
@@ -245,6 +262,43 @@ TEST(TableLoader, RefusesAMalformedTree) {
   with_nodes([](BvhNode* n, std::uint32_t) { n[0].dop_min[4] = n[0].dop_max[4] + 1.0; }, "nodes.dop");
   // The root's right subtree made to skip a node: the walk no longer meets the nodes in order.
   with_nodes([](BvhNode* n, std::uint32_t) { n[0].right_child += 1; }, "nodes");
+}
+
+TEST(TableLoader, RefusesLeafBlocksThatAreNotTheirLeaves) {
+  const auto with_leaves = [this](auto change, const char* field) {
+    tablegen::TableBytes bytes = copy_of(valid_table(), valid_table().size());
+    change(section<LeafBlock>(bytes, TableSection::Leaves), section<BvhNode>(bytes, TableSection::Nodes),
+           header_of(bytes));
+    reseal(bytes);
+    check_refused(bytes, field);
+  };
+  // A point of a block that is not the points section's: a verdict from the lanes would not be the point's.
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[2].y_mm[3] += 0.001F; }, "leaves.points");
+  // A padding lane that is not the last point again.
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader& h) {
+    for (std::uint32_t leaf = 0; leaf < h.leaf_count; ++leaf) {
+      if (b[leaf].point_count < kMaxLeafPoints) {
+        b[leaf].x_mm[kMaxLeafPoints - 1] += 1.0F;
+        return;
+      }
+    }
+    b[0].x_mm[0] += 1.0F;  // every leaf full: any change is refused alike
+  }, "leaves.points");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[0].first_point += 1; }, "leaves");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[1].radius_mm *= 0.5F; }, "leaves.sphere");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[1].centre_mm[2] += 1.0F; }, "leaves.sphere");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[1].radius_mm = -1.0F; }, "leaves.sphere");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) { b[0].reserved[7] = 1; }, "leaves.reserved");
+  // Nodes numbering their blocks out of order, or an internal node naming one.
+  with_leaves([](LeafBlock*, BvhNode* n, const TableHeader& h) {
+    for (std::uint32_t i = 0; i < h.node_count; ++i) {
+      if (n[i].point_count > 0) {
+        n[i].leaf += 1;
+        return;
+      }
+    }
+  }, "nodes.leaf_block");
+  with_leaves([](LeafBlock*, BvhNode* n, const TableHeader&) { n[0].leaf = 1; }, "nodes.leaf_block");
 }
 
 TEST(TableLoader, RefusesAMisalignedBuffer) {

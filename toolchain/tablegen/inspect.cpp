@@ -58,6 +58,11 @@ int inspect_table(const std::string& path, bool json, std::ostream& out, std::os
   }
   tables::PartTables part{};
   const tables::TableLoadResult result = tables::load_tables({bytes.data(), bytes.size()}, part);
+  if (!result.ok && result.expected == tables::kOlderVersion) {
+    err << "stencil-tablegen: " << path << ": format version " << exact(result.value)
+        << ": regenerate with stencil-tablegen (this build reads format version " << tables::kTableFormatVersion << ")\n";
+    return 2;
+  }
   if (!result.ok) {
     err << "stencil-tablegen: " << path << ": " << result.field << " (at " << result.index << "): expected "
         << result.expected << "; found " << exact(result.value) << "\n";
@@ -74,6 +79,7 @@ int inspect_table(const std::string& path, bool json, std::ostream& out, std::os
         {"points", header.point_count},
         {"vertex_points", header.vertex_point_count},
         {"nodes", header.node_count},
+        {"leaves", header.leaf_count},
         {"covering_radius_mm", header.covering_radius_mm},
         {"requested_spacing_mm", header.requested_spacing_mm},
         {"gouge_bound_mm", header.gouge_bound_mm},
@@ -116,7 +122,7 @@ int inspect_table(const std::string& path, bool json, std::ostream& out, std::os
       << header.gouge_bound_mm << " mm, allowance " << header.allowance_mm << " mm\n"
       << "  reachable  " << header.reachable_point_count << " points, " << header.reachable_triangle_count
       << " triangles (3-axis, tool vertical)\n"
-      << "  tree       " << header.node_count << " nodes\n"
+      << "  tree       " << header.node_count << " nodes, " << header.leaf_count << " leaves\n"
       << "  source     " << header.source_bytes << " bytes, " << header.source_triangle_count << " facets ("
       << header.dropped_degenerate_count << " degenerate dropped), sha256 " << hex(header.source_sha256, 32) << "\n";
   return 0;

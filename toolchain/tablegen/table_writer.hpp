@@ -15,12 +15,12 @@ struct TableContents {
   tables::TableHeader header;  // every descriptive field set; counts, sections, sizes and CRC are filled in
   geometry::ToolBsp tool;
   std::vector<tables::PackedPoint> points;
-  std::vector<tables::PackedPoint> normals;
+  std::vector<tables::PackedPoint> normals;  // in the table, in the leaf blocks
   std::vector<std::uint32_t> triangle_ids;
   std::vector<std::uint8_t> point_flags;
   std::vector<tables::PackedTriangle> triangles;
   std::vector<std::uint8_t> triangle_flags;
-  std::vector<tables::BvhNode> nodes;
+  std::vector<tables::BvhNode> nodes;        // assemble_table numbers the leaves' blocks
 };
 
 // Memory for a table, aligned as the loader needs it.

@@ -39,7 +39,7 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // sides' regions when it straddles a partition plane, point by point through the tool tree when
 // it straddles other tests, skipped when the box is wholly outside. For any other axis each point
 // goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
-// on its surface. Either visitor stops the walk by returning false. Iterative, with a fixed stack
+// on its surface (and the leaf's block, for its normal). Either visitor stops the walk by returning false. Iterative, with a fixed stack
 // as deep as the loader allows trees to be.
 enum class Wanted : std::uint8_t {
   Penetrating,  // only points deeper than the tolerance matter (force, legality)
@@ -71,9 +71,10 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     if (node.point_count > 0) {
       if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
-          node.point_count > part.point_count() - node.first_point) {
+          node.point_count > part.point_count() - node.first_point || node.leaf >= part.leaf_count()) {
         return Walk::BadTree;  // a leaf the loader would have refused
       }
+      const tables::LeafBlock& block = part.leaves[node.leaf];
       if (upright) {
         const geometry::BoxClassification cover =
             geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
@@ -86,7 +87,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             cover.deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm) {
           continue;
         }
-        load_leaf(part, node.first_point, node.point_count, pose.tip_mm, leaf);
+        load_leaf(part, block, pose.tip_mm, leaf);
         bool finite = false;
         switch (cover.cover) {
           case geometry::BoxCover::Region:
@@ -116,7 +117,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         if (result.contact == geometry::PointContact::BadTree) {
           return Walk::BadTree;
         }
-        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result)) {
+        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result, block)) {
           return Walk::Stopped;
         }
       }
@@ -131,9 +132,10 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   return Walk::Finished;
 }
 
-Eigen::Vector3d normal_of(const tables::PartTables& part, std::uint32_t point) {
-  const tables::PackedPoint& n = part.normals[point];
-  return {n.x_mm, n.y_mm, n.z_mm};
+// The normal of `point`, of the leaf whose block is `block`.
+Eigen::Vector3d normal_of(const tables::LeafBlock& block, std::uint32_t point) {
+  const std::uint32_t lane = point - block.first_point;
+  return {block.nx[lane], block.ny[lane], block.nz[lane]};
 }
 
 
@@ -157,14 +159,14 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
       result.deepest_point = i;
     }
   };
-  const auto visit_point = [&](std::uint32_t i, const geometry::PointClassification& c) {
+  const auto visit_point = [&](std::uint32_t i, const geometry::PointClassification& c, const tables::LeafBlock& block) {
     if (c.contact != geometry::PointContact::Penetrating) {
       return true;
     }
     count_depth(i, c.depth_mm);
     // The part pushes the tool out along the point's normal; the tool's own escape direction says
     // the same from the other side. Their average is robust where one of them is poor.
-    Eigen::Vector3d direction = normal_of(part, i) - c.escape_direction;
+    Eigen::Vector3d direction = normal_of(block, i) - c.escape_direction;
     const double length = direction.norm();
     if (length < kNoDirection) {
       return true;  // the two disagree completely: this point gives no direction
@@ -211,7 +213,7 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
   }
   const Walk walk = walk_points_in_tool(
       part, part.tool, pose, Wanted::Penetrating,
-      [](std::uint32_t, const geometry::PointClassification& c) {
+      [](std::uint32_t, const geometry::PointClassification& c, const tables::LeafBlock&) {
         return c.contact != geometry::PointContact::Penetrating;
       },
       [](const LeafContacts& leaf) { return leaf.penetrating == 0; });
@@ -235,7 +237,7 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
   const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
   static_cast<void>(walk_points_in_tool(
       part, contact_tool, inflated, Wanted::InTool,
-      [&](std::uint32_t i, const geometry::PointClassification&) {
+      [&](std::uint32_t i, const geometry::PointClassification&, const tables::LeafBlock&) {
         touched.insert(part.triangle_ids[i]);
         return true;
       },

@@ -261,76 +261,13 @@ void summarise(float band, ExactDepth&& exact, LeafContacts& leaf) {
   });
 }
 
-// Widens `count` packed triples (x, y, z floats one after another) into three lanes, less
-// `high` and then `low` per axis. Lanes past count repeat the last triple, so every lane holds
-// finite numbers.
-void widen_triples(const float* packed, std::uint32_t count, const std::array<float, 3>& high,
-                   const std::array<float, 3>& low, float* x, float* y, float* z) {
-#if defined(__AVX2__)
-  // Eight triples at a time: three loads, two blends and a permute per axis, where the compiler
-  // would insert each float on its own. Lane i of the blend of a, b, c below holds x, y or z of a
-  // different triple; the permute puts them in order. The block holding the leaf's end loads only
-  // its own floats (masked loads never touch memory outside the mask), and its lanes past count
-  // take the last triple. Every lane is written by one whole-vector store, which the kernels' loads
-  // right after are forwarded from.
-  const __m256i x_order = _mm256_setr_epi32(0, 3, 6, 1, 4, 7, 2, 5);
-  const __m256i y_order = _mm256_setr_epi32(1, 4, 7, 2, 5, 0, 3, 6);
-  const __m256i z_order = _mm256_setr_epi32(2, 5, 0, 3, 6, 1, 4, 7);
-  const __m256i lane_index = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
-  const float* last = packed + 3 * (count - 1);
-  const __m256 last_x = _mm256_set1_ps(last[0]), last_y = _mm256_set1_ps(last[1]), last_z = _mm256_set1_ps(last[2]);
-  const __m256 high_x = _mm256_set1_ps(high[0]), high_y = _mm256_set1_ps(high[1]), high_z = _mm256_set1_ps(high[2]);
-  const __m256 low_x = _mm256_set1_ps(low[0]), low_y = _mm256_set1_ps(low[1]), low_z = _mm256_set1_ps(low[2]);
-  for (std::uint32_t base = 0; base < kLanes; base += 8) {
-    __m256 xs = last_x, ys = last_y, zs = last_z;
-    if (base < count) {
-      const float* block = packed + 3 * base;
-      __m256 a, b, c;  // x0 y0 z0 x1 y1 z1 x2 y2 | z2 x3 y3 z3 x4 y4 z4 x5 | y5 z5 x6 y6 z6 x7 y7 z7
-      const std::uint32_t triples = count - base;
-      if (triples >= 8) {
-        a = _mm256_loadu_ps(block);
-        b = _mm256_loadu_ps(block + 8);
-        c = _mm256_loadu_ps(block + 16);
-      } else {
-        const __m256i floats = _mm256_set1_epi32(static_cast<int>(3 * triples));
-        a = _mm256_maskload_ps(block, _mm256_cmpgt_epi32(floats, lane_index));
-        b = _mm256_maskload_ps(block + 8, _mm256_cmpgt_epi32(floats, _mm256_add_epi32(lane_index, _mm256_set1_epi32(8))));
-        c = _mm256_maskload_ps(block + 16,
-                               _mm256_cmpgt_epi32(floats, _mm256_add_epi32(lane_index, _mm256_set1_epi32(16))));
-      }
-      xs = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x92), c, 0x24), x_order);
-      ys = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x24), c, 0x49), y_order);
-      zs = _mm256_permutevar8x32_ps(_mm256_blend_ps(_mm256_blend_ps(a, b, 0x49), c, 0x92), z_order);
-      if (triples < 8) {
-        const __m256 past = _mm256_castsi256_ps(
-            _mm256_cmpgt_epi32(lane_index, _mm256_set1_epi32(static_cast<int>(triples) - 1)));
-        xs = _mm256_blendv_ps(xs, last_x, past);
-        ys = _mm256_blendv_ps(ys, last_y, past);
-        zs = _mm256_blendv_ps(zs, last_z, past);
-      }
-    }
-    _mm256_storeu_ps(x + base, _mm256_sub_ps(_mm256_sub_ps(xs, high_x), low_x));
-    _mm256_storeu_ps(y + base, _mm256_sub_ps(_mm256_sub_ps(ys, high_y), low_y));
-    _mm256_storeu_ps(z + base, _mm256_sub_ps(_mm256_sub_ps(zs, high_z), low_z));
-  }
-  return;
-#else
-  for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
-    const std::uint32_t from = 3 * std::min(lane, count - 1);
-    x[lane] = (packed[from] - high[0]) - low[0];
-    y[lane] = (packed[from + 1] - high[1]) - low[1];
-    z[lane] = (packed[from + 2] - high[2]) - low[2];
-  }
-#endif
-}
-
 }  // namespace
 
-void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, const Eigen::Vector3d& tip_mm,
+void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf) {
-  leaf.first = first;
-  leaf.count = count;
-  leaf.points = &part.points[first];
+  leaf.first = block.first_point;
+  leaf.count = block.point_count;
+  leaf.points = &part.points[block.first_point];
   leaf.tip_mm = tip_mm;
   // The tip as a float and the float of what that leaves out: (p - high) - low is the offset to
   // within a rounding of its own size, however far the part is from the origin. The split is
@@ -343,15 +280,18 @@ void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_
     const double scaled = kVeltkamp * tip_mm[axis];
     head[static_cast<std::size_t>(axis)] = scaled - (scaled - tip_mm[axis]);
   }
-  const std::array<float, 3> high = {static_cast<float>(head[0]), static_cast<float>(head[1]),
-                                     static_cast<float>(head[2])};
-  const std::array<float, 3> low = {static_cast<float>(tip_mm.x() - head[0]), static_cast<float>(tip_mm.y() - head[1]),
-                                    static_cast<float>(tip_mm.z() - head[2])};
-  static_assert(sizeof(tables::PackedPoint) == 3 * sizeof(float));
-  widen_triples(&part.points[first].x_mm, count, high, low, leaf.x.data(), leaf.y.data(), leaf.z.data());
-  widen_triples(&part.normals[first].x_mm, count, {}, {}, leaf.nx.data(), leaf.ny.data(), leaf.nz.data());
+  const auto high_x = static_cast<float>(head[0]), high_y = static_cast<float>(head[1]), high_z = static_cast<float>(head[2]);
+  const auto low_x = static_cast<float>(tip_mm.x() - head[0]), low_y = static_cast<float>(tip_mm.y() - head[1]),
+             low_z = static_cast<float>(tip_mm.z() - head[2]);
+  // The block's lanes are the leaf's points, the last repeated past count: plain vector loads.
   LeafLanes size;
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
+    leaf.x[lane] = (block.x_mm[lane] - high_x) - low_x;
+    leaf.y[lane] = (block.y_mm[lane] - high_y) - low_y;
+    leaf.z[lane] = (block.z_mm[lane] - high_z) - low_z;
+    leaf.nx[lane] = block.nx[lane];
+    leaf.ny[lane] = block.ny[lane];
+    leaf.nz[lane] = block.nz[lane];
     size[lane] = std::abs(leaf.x[lane]) + std::abs(leaf.y[lane]) + std::abs(leaf.z[lane]);
   }
   leaf.magnitude_mm = lane_max(size);

@@ -56,9 +56,10 @@ struct LeafContacts {
   std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
 };
 
-// Loads the leaf's points (as offsets from tip_mm) and normals into the lanes. count must be 1 to
-// kMaxLeafPoints and the run inside the tables (the walk checks it).
-void load_leaf(const tables::PartTables& part, std::uint32_t first, std::uint32_t count, const Eigen::Vector3d& tip_mm,
+// Loads the leaf's points (as offsets from tip_mm) and normals into the lanes from its packed
+// block. The block's count must be 1 to kMaxLeafPoints and its run inside the tables (the loader
+// checks it, the walk again).
+void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf);
 
 // Every point of the leaf lies in region `region` of the upright tool or, when `or_outside`,

@@ -7,7 +7,8 @@
 //                   with zero bytes between them; the header's section table gives offset and size.
 //     Tool          ToolSection: the tool's BSP tree as built from the header's tool spec
 //     Points        PackedPoint[point_count]: world millimetres, in BVH leaf order
-//     Normals       PackedPoint[point_count]: unit outward normal of each point's triangle
+//     Leaves        LeafBlock[leaf_count]: each leaf's points and their unit outward normals (of
+//                   each point's triangle) as float lanes, with a sphere bounding the points
 //     TriangleIds   uint32[point_count]: the triangle each point lies on
 //     PointFlags    uint8[point_count]: kPointReachable
 //     Triangles     PackedTriangle[triangle_count]: the part's mesh for display (world mm)
@@ -25,7 +26,9 @@ namespace stencil::tables {
 static_assert(std::endian::native == std::endian::little, "tables are read in place: little-endian hosts only");
 
 inline constexpr std::uint8_t kTableMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L', 'T'};
-inline constexpr std::uint32_t kTableFormatVersion = 1;
+// 2: the packed leaves (LeafBlock) replace version 1's per-point normals; the loader refuses
+// version 1 tables by name, with "regenerate with stencil-tablegen".
+inline constexpr std::uint32_t kTableFormatVersion = 2;
 inline constexpr std::size_t kSectionAlignment = 64;
 inline constexpr std::size_t kCrcStartOffset = 20;
 
@@ -43,7 +46,7 @@ inline constexpr std::uint32_t kMaxTreeDepth = 64;
 enum class TableSection : std::uint32_t {
   Tool = 0,
   Points,
-  Normals,
+  Leaves,
   TriangleIds,
   PointFlags,
   Triangles,
@@ -85,7 +88,7 @@ struct TableHeader {
   std::uint64_t seed;                // --seed for the extra random points
   std::uint64_t extra_points;        // --extra-points
   std::uint32_t tool_kind;           // geometry::CutterKind
-  std::uint32_t reserved0;
+  std::uint32_t leaf_count;         // the tree's leaves: one LeafBlock each
   double tool_diameter_mm;
   double tool_flute_length_mm;
   double tool_corner_radius_mm;
@@ -127,10 +130,32 @@ struct BvhNode {
   std::uint32_t first_point;
   std::uint32_t point_count;
   std::uint32_t right_child;
-  std::uint32_t reserved;
+  std::uint32_t leaf;  // a leaf's LeafBlock (leaves numbered in depth-first order); 0 for an internal node
 };
 static_assert(sizeof(BvhNode) == 128);
 static_assert(offsetof(BvhNode, first_point) == 112);
+
+// One leaf of the points' tree packed for the query's lanes: its points and their normals as
+// float lanes, ready for vector loads without gathering (the block and each array are 64- and
+// 32-byte aligned in the file), lanes past point_count repeating the last point, so every lane
+// holds a real point. The points are the very floats of the Points section, so a verdict taken
+// in double precision from a lane is the one taken from the point. The sphere bounds every point of
+// the leaf in double precision, for settling a whole leaf from its distance to a tool surface.
+struct LeafBlock {
+  float x_mm[kMaxLeafPoints];
+  float y_mm[kMaxLeafPoints];
+  float z_mm[kMaxLeafPoints];
+  float nx[kMaxLeafPoints];  // unit outward normal of each point's triangle
+  float ny[kMaxLeafPoints];
+  float nz[kMaxLeafPoints];
+  std::uint32_t first_point;  // the leaf's node's first_point and point_count
+  std::uint32_t point_count;
+  float centre_mm[3];         // every point within radius_mm of it (in double precision)
+  float radius_mm;
+  std::uint8_t reserved[40];
+};
+static_assert(sizeof(LeafBlock) == 832 && sizeof(LeafBlock) % 64 == 0, "blocks stay 64-byte aligned in the file");
+static_assert(offsetof(LeafBlock, nx) == 384 && offsetof(LeafBlock, first_point) == 768);
 
 // The tool's BSP tree in the file: the fields of geometry::ToolBsp, each byte defined.
 struct ToolSectionSurface {

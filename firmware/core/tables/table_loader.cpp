@@ -1,6 +1,7 @@
 // Validation of table bytes, in the order that lets each check trust the ones before it.
 #include "firmware/core/tables/table_loader.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -19,6 +20,12 @@ constexpr double kUnitLengthTolerance = 1e-5;
 
 TableLoadResult ok() { return {true, nullptr, nullptr, 0, 0.0}; }
 
+}  // namespace
+
+const char* const kOlderVersion = "format version 2 (an older format: regenerate the table with stencil-tablegen)";
+
+namespace {
+
 TableLoadResult refuse(const char* field, const char* expected, std::uint64_t index, double value) {
   return {false, field, expected, index, value};
 }
@@ -32,7 +39,7 @@ struct ElementSize {
 constexpr std::array<ElementSize, kSectionCount> kSectionElements = {{
     {TableSection::Tool, "sections.tool", sizeof(ToolSection)},
     {TableSection::Points, "sections.points", sizeof(PackedPoint)},
-    {TableSection::Normals, "sections.normals", sizeof(PackedPoint)},
+    {TableSection::Leaves, "sections.leaves", sizeof(LeafBlock)},
     {TableSection::TriangleIds, "sections.triangle_ids", sizeof(std::uint32_t)},
     {TableSection::PointFlags, "sections.point_flags", sizeof(std::uint8_t)},
     {TableSection::Triangles, "sections.triangles", sizeof(PackedTriangle)},
@@ -45,7 +52,6 @@ std::uint64_t element_count(const TableHeader& header, TableSection section) {
     case TableSection::Tool:
       return 1;
     case TableSection::Points:
-    case TableSection::Normals:
     case TableSection::TriangleIds:
     case TableSection::PointFlags:
       return header.point_count;
@@ -54,6 +60,8 @@ std::uint64_t element_count(const TableHeader& header, TableSection section) {
       return header.triangle_count;
     case TableSection::Nodes:
       return header.node_count;
+    case TableSection::Leaves:
+      return header.leaf_count;
     case TableSection::Count:
       break;
   }
@@ -75,7 +83,10 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
     return refuse("header.magic", "the bytes \"STENCILT\" (not a stencil table file)", 0, 0.0);
   }
   if (header.format_version != kTableFormatVersion) {
-    return refuse("header.format_version", "format version 1", 8, header.format_version);
+    // Earlier versions are tables this build could read once: they are to be made again, not repaired.
+    return refuse("header.format_version",
+                  header.format_version < kTableFormatVersion ? kOlderVersion : "format version 2 (a newer stencil-tablegen made it)",
+                  8, header.format_version);
   }
   if (header.header_bytes != sizeof(TableHeader)) {
     return refuse("header.header_bytes", "512", 12, header.header_bytes);
@@ -99,6 +110,9 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
   }
   if (header.node_count == 0 || header.node_count > kMaxTableNodes) {
     return refuse("header.node_count", "between 1 and 1048576", 40, header.node_count);
+  }
+  if (header.leaf_count == 0 || header.leaf_count > header.node_count || header.leaf_count > header.point_count) {
+    return refuse("header.leaf_count", "between 1 and node_count, at most point_count", 308, header.leaf_count);
   }
   if (header.vertex_point_count > header.point_count) {
     return refuse("header.vertex_point_count", "at most point_count", 44, header.vertex_point_count);
@@ -166,13 +180,6 @@ TableLoadResult check_points(const PartTables& tables) {
     if (!finite_point(tables.points[i])) {
       return refuse("points", "finite coordinates", i, first_non_finite(tables.points[i]));
     }
-    if (!finite_point(tables.normals[i])) {
-      return refuse("normals", "finite components", i, first_non_finite(tables.normals[i]));
-    }
-    const double length = to_vector(tables.normals[i]).norm();
-    if (std::abs(length - 1.0) > kUnitLengthTolerance) {
-      return refuse("normals", "unit length", i, length);
-    }
     if (tables.triangle_ids[i] >= tables.triangle_count()) {
       return refuse("triangle_ids", "less than triangle_count", i, tables.triangle_ids[i]);
     }
@@ -188,6 +195,51 @@ TableLoadResult check_points(const PartTables& tables) {
     }
     if ((tables.triangle_flags[i] & ~kTriangleReachable) != 0) {
       return refuse("triangle_flags", "only the reachable bit", i, tables.triangle_flags[i]);
+    }
+  }
+  return ok();
+}
+
+bool same_float(float a, float b) { return std::memcmp(&a, &b, sizeof(float)) == 0; }
+
+// The leaf's block: its run of points, lane for lane the very floats of the Points section (lanes
+// past the count repeating the last), unit normals likewise, a sphere bounding the points, zeros
+// where reserved.
+TableLoadResult check_leaf_block(const PartTables& tables, const BvhNode& node, std::uint32_t leaf) {
+  const LeafBlock& block = tables.leaves[leaf];
+  if (block.first_point != node.first_point || block.point_count != node.point_count) {
+    return refuse("leaves", "the run of points of its leaf node", leaf, block.first_point);
+  }
+  const Eigen::Vector3d centre(block.centre_mm[0], block.centre_mm[1], block.centre_mm[2]);
+  if (!centre.allFinite() || !std::isfinite(block.radius_mm) || block.radius_mm < 0.0F) {
+    return refuse("leaves.sphere", "a finite centre and a finite radius, not negative", leaf, block.radius_mm);
+  }
+  for (std::uint32_t lane = 0; lane < kMaxLeafPoints; ++lane) {
+    const PackedPoint& point = tables.points[node.first_point + std::min(lane, node.point_count - 1)];
+    if (!same_float(block.x_mm[lane], point.x_mm) || !same_float(block.y_mm[lane], point.y_mm) ||
+        !same_float(block.z_mm[lane], point.z_mm)) {
+      return refuse("leaves.points", "the leaf's points as in the points section, the last repeated", leaf, lane);
+    }
+    const PackedPoint normal{block.nx[lane], block.ny[lane], block.nz[lane]};
+    if (!finite_point(normal)) {
+      return refuse("leaves.normals", "finite components", leaf, first_non_finite(normal));
+    }
+    const double length = to_vector(normal).norm();
+    if (std::abs(length - 1.0) > kUnitLengthTolerance) {
+      return refuse("leaves.normals", "unit length", leaf, length);
+    }
+    const std::uint32_t last = node.point_count - 1;
+    if (lane > last && (!same_float(block.nx[lane], block.nx[last]) || !same_float(block.ny[lane], block.ny[last]) ||
+                        !same_float(block.nz[lane], block.nz[last]))) {
+      return refuse("leaves.normals", "past the leaf's points, its last point's normal", leaf, lane);
+    }
+    if ((to_vector(point) - centre).norm() > double{block.radius_mm}) {
+      return refuse("leaves.sphere", "a sphere holding every point of the leaf", leaf, lane);
+    }
+  }
+  for (const std::uint8_t byte : block.reserved) {
+    if (byte != 0) {
+      return refuse("leaves.reserved", "0", leaf, byte);
     }
   }
   return ok();
@@ -236,6 +288,7 @@ TableLoadResult check_tree(const PartTables& tables) {
   stack[stack_size++] = {0, 0, 1};
   std::uint32_t next_node = 0;
   std::uint32_t next_point = 0;
+  std::uint32_t next_leaf = 0;
   while (stack_size > 0) {
     const Pending pending = stack[--stack_size];
     if (pending.node != next_node) {
@@ -259,8 +312,20 @@ TableLoadResult check_tree(const PartTables& tables) {
           return refuse("nodes.dop", "bounds every point of the leaf", pending.node, i);
         }
       }
+      if (node.leaf != next_leaf || next_leaf >= tables.leaf_count()) {
+        return refuse("nodes.leaf_block", "the leaves numbered in depth-first order, fewer than leaf_count",
+                      pending.node, node.leaf);
+      }
+      const TableLoadResult block = check_leaf_block(tables, node, next_leaf);
+      if (!block.ok) {
+        return block;
+      }
+      ++next_leaf;
       next_point += node.point_count;
       continue;
+    }
+    if (node.leaf != 0) {
+      return refuse("nodes.leaf_block", "0 for an internal node", pending.node, node.leaf);
     }
     const std::uint32_t left = pending.node + 1;
     if (node.right_child <= left || node.right_child >= tables.node_count() || left >= tables.node_count()) {
@@ -275,6 +340,9 @@ TableLoadResult check_tree(const PartTables& tables) {
   }
   if (next_node != tables.node_count()) {
     return refuse("nodes", "every node reached from the root", next_node, tables.node_count());
+  }
+  if (next_leaf != tables.leaf_count()) {
+    return refuse("header.leaf_count", "the number of leaves in the tree", next_leaf, tables.leaf_count());
   }
   if (next_point != tables.point_count()) {
     return refuse("nodes.leaf", "leaves covering every point", next_point, tables.point_count());
@@ -327,12 +395,12 @@ TableLoadResult load_tables(std::span<const std::byte> bytes, PartTables& tables
     return result;
   }
   candidate.points = reinterpret_cast<const PackedPoint*>(at(TableSection::Points));
-  candidate.normals = reinterpret_cast<const PackedPoint*>(at(TableSection::Normals));
   candidate.triangle_ids = reinterpret_cast<const std::uint32_t*>(at(TableSection::TriangleIds));
   candidate.point_flags = reinterpret_cast<const std::uint8_t*>(at(TableSection::PointFlags));
   candidate.triangles = reinterpret_cast<const PackedTriangle*>(at(TableSection::Triangles));
   candidate.triangle_flags = reinterpret_cast<const std::uint8_t*>(at(TableSection::TriangleFlags));
   candidate.nodes = reinterpret_cast<const BvhNode*>(at(TableSection::Nodes));
+  candidate.leaves = reinterpret_cast<const LeafBlock*>(at(TableSection::Leaves));
   result = check_points(candidate);
   if (!result.ok) {
     return result;
