@@ -38,6 +38,7 @@ struct LeafPoints {
   std::array<tables::PackedPoint, tables::kMaxLeafPoints> points{};
   std::array<tables::PackedPoint, tables::kMaxLeafPoints> normals{};
   tables::PartTables part{};
+  mutable tables::LeafBlock block{};
   std::uint32_t count = 0;
 
   LeafPoints(const Eigen::Vector3d& centre, const Eigen::Vector3d& half, std::uint32_t n, const Eigen::Vector3d& tip = kTip)
@@ -55,8 +56,9 @@ struct LeafPoints {
 
   // The leaf's block as the table generator packs it, from the points and normals as they are now
   // (lanes past count repeat the last point; no sphere: load_leaf does not read it).
-  [[nodiscard]] tables::LeafBlock packed() const {
-    tables::LeafBlock block{};
+  // The block lives in this object: a loaded leaf reads its normals from it.
+  [[nodiscard]] const tables::LeafBlock& packed() const {
+    block = tables::LeafBlock{};
     block.first_point = 0;
     block.point_count = count;
     for (std::uint32_t lane = 0; lane < tables::kMaxLeafPoints; ++lane) {
@@ -171,7 +173,7 @@ void check_loaded(const LeafPoints& points, const Eigen::Vector3d& tip, const Le
     DOUBLES_EQUAL(offset.x(), double{leaf.x[lane]}, 1e-7);
     DOUBLES_EQUAL(offset.y(), double{leaf.y[lane]}, 1e-7);
     DOUBLES_EQUAL(offset.z(), double{leaf.z[lane]}, 1e-7);
-    DOUBLES_EQUAL(double{points.normals[std::min(lane, points.count - 1)].y_mm}, double{leaf.ny[lane]}, 0.0);
+    DOUBLES_EQUAL(double{points.normals[std::min(lane, points.count - 1)].y_mm}, double{leaf.normals->ny[lane]}, 0.0);
     largest = std::max(largest, std::abs(leaf.x[lane]) + std::abs(leaf.y[lane]) + std::abs(leaf.z[lane]));
   }
   DOUBLES_EQUAL(double{largest}, double{leaf.magnitude_mm}, 0.0);

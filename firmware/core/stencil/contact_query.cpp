@@ -6,6 +6,10 @@
 
 #include <Eigen/Geometry>
 
+#if defined(__AVX2__)
+#include <immintrin.h>
+#endif
+
 #include "firmware/core/geometry/kdop14.hpp"
 #include "firmware/core/geometry/meridian_box.hpp"
 #include "firmware/core/geometry/tool_bound.hpp"
@@ -22,13 +26,29 @@ bool pose_is_usable(const ToolPose& pose) {
   return pose.tip_mm.allFinite() && pose.axis.allFinite() && std::abs(pose.axis.squaredNorm() - 1.0) < 1e-9;
 }
 
+// Whether the tool's volume and the node's 14-DOP overlap on every slab. With AVX2, the seven
+// slabs as two overlapping runs of four (slabs 0-3 and 3-6), all compared at once and without a
+// branch per slab: the walk tests every node it meets, most of them overlapping (deep contact),
+// where the loop would run all seven slabs. The same comparisons, so the same answer.
 bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) {
+  static_assert(geometry::kKdopSlabCount == 7);
+#if defined(__AVX2__)
+  const auto separated = [&](std::size_t first) {
+    const __m256d below = _mm256_cmp_pd(_mm256_loadu_pd(volume.min.data() + first),
+                                        _mm256_loadu_pd(node.dop_max + first), _CMP_GT_OQ);
+    const __m256d above = _mm256_cmp_pd(_mm256_loadu_pd(node.dop_min + first),
+                                        _mm256_loadu_pd(volume.max.data() + first), _CMP_GT_OQ);
+    return _mm256_or_pd(below, above);
+  };
+  return _mm256_movemask_pd(_mm256_or_pd(separated(0), separated(3))) == 0;
+#else
   for (std::size_t slab = 0; slab < geometry::kKdopSlabCount; ++slab) {
     if (volume.min[slab] > node.dop_max[slab] || node.dop_min[slab] > volume.max[slab]) {
       return false;
     }
   }
   return true;
+#endif
 }
 
 // Walks the points' tree for the tool at `pose`. Leaves are culled by the tool's 14-DOP and, for

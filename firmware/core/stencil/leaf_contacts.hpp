@@ -41,9 +41,7 @@ struct LeafContacts {
   alignas(32) LeafLanes x;            // offset of each point from the tip, world mm
   alignas(32) LeafLanes y;
   alignas(32) LeafLanes z;
-  alignas(32) LeafLanes nx;  // the points' normals
-  alignas(32) LeafLanes ny;
-  alignas(32) LeafLanes nz;
+  const tables::LeafBlock* normals;  // the leaf's block, whose nx, ny, nz are the points' normals
   alignas(32) LeafLanes depth;  // > 0 exactly in the lanes that penetrate beyond kSurfaceTolerance_mm
                                 // (the double-precision verdict); 0 elsewhere and past count
   alignas(32) LeafLanes ex;     // escape direction in world frame; 0 for points outside the tool
@@ -56,9 +54,9 @@ struct LeafContacts {
   std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
 };
 
-// Loads the leaf's points (as offsets from tip_mm) and normals into the lanes from its packed
-// block. The block's count must be 1 to kMaxLeafPoints and its run inside the tables (the loader
-// checks it, the walk again).
+// Loads the leaf's points (as offsets from tip_mm) into the lanes from its packed block, and keeps
+// the block for its normals (it must outlive the leaf's use). The block's count must be 1 to
+// kMaxLeafPoints and its run inside the tables (the loader checks it, the walk again).
 void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf);
 
