@@ -19,17 +19,19 @@ if ! git cat-file -e "$commit^{commit}" 2> /dev/null; then
   exit 1
 fi
 src="$out-src"
-if [ ! -f "$src/CMakeLists.txt" ]; then
+# The commit the sources are from, so a tree extracted from any other is replaced.
+if [ ! -f "$src/CMakeLists.txt" ] || [ "$(cat "$src.commit" 2> /dev/null)" != "$commit" ]; then
   echo "bench-previous: extracting ${commit:0:7} into $src"
   rm -rf "$src"
   mkdir -p "$src"
   git archive "$commit" | tar -x -C "$src"
+  echo "$commit" > "$src.commit"
 fi
 # Today's harness (only a changed one is copied, so the build stays incremental).
 cmp -s tests/bench/stencil_bench.cpp "$src/tests/bench/stencil_bench.cpp" ||
   cp tests/bench/stencil_bench.cpp "$src/tests/bench/stencil_bench.cpp"
 cmake -S "$src" -B "$out" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DCMAKE_TOOLCHAIN_FILE="$PWD/$src/toolchain/cmake/host.cmake" -DSTENCIL_BUILD_TESTS=OFF \
+  -DCMAKE_TOOLCHAIN_FILE="$(realpath "$src")/toolchain/cmake/host.cmake" -DSTENCIL_BUILD_TESTS=OFF \
   -DCMAKE_CXX_FLAGS=-DSTENCIL_BENCH_PREVIOUS > /dev/null
 cmake --build "$out" --target stencil-bench stencil-tablegen
 echo "bench-previous: $out/bin/stencil-bench and $out/bin/stencil-tablegen (commit ${commit:0:7})"

@@ -16,6 +16,7 @@ std::string describe_refusal(const tables::TableLoadResult& refused) {
            std::to_string(tables::kTableFormatVersion) + ")";
   }
   std::ostringstream text;
+  text.precision(17);  // a CRC or a byte count whole, a coordinate to its last digit
   text << "not a valid table: " << refused.field << " (at " << refused.index << "): expected " << refused.expected
        << ", found " << refused.value;
   return text.str();

@@ -91,7 +91,9 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     if (node.point_count > 0) {
       if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
-          node.point_count > part.point_count() - node.first_point || node.leaf >= part.leaf_count()) {
+          node.point_count > part.point_count() - node.first_point || node.leaf >= part.leaf_count() ||
+          part.leaves[node.leaf].first_point != node.first_point ||
+          part.leaves[node.leaf].point_count != node.point_count) {
         return Walk::BadTree;  // a leaf the loader would have refused
       }
       const tables::LeafBlock& block = part.leaves[node.leaf];

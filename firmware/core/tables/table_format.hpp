@@ -140,7 +140,8 @@ static_assert(offsetof(BvhNode, first_point) == 112);
 // 32-byte aligned in the file), lanes past point_count repeating the last point, so every lane
 // holds a real point. The points are the very floats of the Points section, so a verdict taken
 // in double precision from a lane is the one taken from the point. The sphere bounds every point of
-// the leaf in double precision, for settling a whole leaf from its distance to a tool surface.
+// the leaf in double precision (checked by the loader; not yet used by the query: it is there for
+// settling a whole leaf from its distance to a tool surface).
 struct LeafBlock {
   float x_mm[kMaxLeafPoints];
   float y_mm[kMaxLeafPoints];

@@ -22,7 +22,7 @@ TableLoadResult ok() { return {true, nullptr, nullptr, 0, 0.0}; }
 
 }  // namespace
 
-const char* const kOlderVersion = "format version 2 (an older format: regenerate the table with stencil-tablegen)";
+const char* const kOlderVersion = "format version 2 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
 
 namespace {
 
@@ -84,8 +84,11 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
   }
   if (header.format_version != kTableFormatVersion) {
     // Earlier versions are tables this build could read once: they are to be made again, not repaired.
+    static_assert(kTableFormatVersion == 2, "the texts below name the version");
     return refuse("header.format_version",
-                  header.format_version < kTableFormatVersion ? kOlderVersion : "format version 2 (a newer stencil-tablegen made it)",
+                  header.format_version >= 1 && header.format_version < kTableFormatVersion
+                      ? kOlderVersion
+                      : "format version 2 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
                   8, header.format_version);
   }
   if (header.header_bytes != sizeof(TableHeader)) {
