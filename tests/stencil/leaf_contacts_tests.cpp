@@ -327,3 +327,53 @@ TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
   DOUBLES_EQUAL(10.0 * leaf.max_depth_mm, up.force.z(), 1e-5);
   DOUBLES_EQUAL(0.0, up.force.head<2>().norm(), 1e-7);
 }
+
+TEST(LeafContacts, TheOnePassForceOfALeafInOneRegionIsTheStepByStepOneBitForBit) {
+  // Leaves in the ball, by the flutes' side, under the holder's step, by its concave edge, and
+  // across the ball's surface: every kind of surface a region can have.
+  const std::array<std::pair<Eigen::Vector3d, Eigen::Vector3d>, 7> leaves{{
+      {{0.2, 0.1, 0.6}, {0.15, 0.15, 0.1}},
+      {{0.1, 0.0, 0.0}, {0.05, 0.05, 0.02}},
+      {{1.2, 0.3, 6.0}, {0.1, 0.1, 0.3}},
+      {{3.0, 0.5, 12.2}, {0.1, 0.1, 0.05}},
+      {{1.0, 0.2, 12.3}, {0.05, 0.05, 0.05}},
+      {{4.8, 0.0, 20.0}, {0.05, 0.05, 0.2}},
+      {{0.0, 0.0, 31.9}, {0.2, 0.2, 0.05}},
+  }};
+  std::uint32_t kinds_seen = 0;
+  for (const auto& [centre, half] : leaves) {
+    for (const std::uint32_t count : {32U, 13U}) {
+      const LeafPoints points(centre, half, count);
+      const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+      CHECK_TEXT(cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside,
+                 "each leaf lies in one region, or in it or outside");
+      const bool or_outside = cover.cover == geometry::BoxCover::RegionOrOutside;
+      kinds_seen |= 1U << static_cast<unsigned>(tool.surfaces[tool.regions[cover.region].surface].kind);
+      load_leaf(points.part, points.packed(), kTip, leaf);
+      for (const bool find_deepest : {true, false}) {
+        RegionLeafForce one_pass{};
+        CHECK(region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
+        LeafContacts step_by_step = leaf;
+        CHECK(region_leaf_contacts(tool, cover.region, or_outside, step_by_step));
+        const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
+        LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
+        CHECK(one_pass.penetrating > 0);
+        DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
+        LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
+        CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
+        CHECK(sums.torque == one_pass.sums.torque);
+      }
+    }
+  }
+  LONGS_EQUAL(0xF, kinds_seen);  // plane, cylinder, sphere and torus
+}
+
+TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {
+  const LeafPoints points(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), 8);
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  geometry::ToolBsp damaged = tool;
+  damaged.surfaces[damaged.regions[cover.region].surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
+  load_leaf(points.part, points.packed(), kTip, leaf);
+  RegionLeafForce out{};
+  CHECK_FALSE(region_leaf_force(damaged, cover.region, false, true, 10.0, 7.5, leaf, out));
+}

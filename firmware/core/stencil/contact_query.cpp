@@ -57,18 +57,36 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // and escape directions computed lane-wise: from one region's surface when the leaf's box lies in
 // that region or just straddles its boundary (no walk of the tool tree per point), from the two
 // sides' regions when it straddles a partition plane, point by point through the tool tree when
-// it straddles other tests, skipped when the box is wholly outside. For any other axis each point
-// goes through classify_at_pose and visit_point(index, classification) gets those in the tool or
-// on its surface (and the leaf's block, for its normal). Either visitor stops the walk by returning false. Iterative, with a fixed stack
-// as deep as the loader allows trees to be.
+// it straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it
+// or outside) goes loaded to visit_region_leaf(cover, leaf), which settles its lanes itself (the
+// query computes its force in the same pass) and answers a LeafVisit; the others go settled to
+// visit_leaf. For any other axis each point goes through classify_at_pose and
+// visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
+// block, for its normal). visit_point and visit_leaf stop the walk by returning false. Iterative,
+// with a fixed stack as deep as the loader allows trees to be.
 enum class Wanted : std::uint8_t {
   Penetrating,  // only points deeper than the tolerance matter (force, legality)
   InTool,       // points on the surface matter too (touched triangles)
 };
 
-template <typename VisitPoint, typename VisitLeaf>
+// What a visitor of a leaf tells the walk.
+enum class LeafVisit : std::uint8_t { Continue, Stop, Fault };
+
+// A leaf wholly in one region (or in it or outside), its lanes settled, given to visit_leaf: the
+// visit of a settled leaf for walkers that want every lane's verdict.
+template <typename VisitLeaf>
+LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                             LeafContacts& leaf, VisitLeaf& visit_leaf) {
+  if (!region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf)) {
+    return LeafVisit::Fault;
+  }
+  return visit_leaf(leaf) ? LeafVisit::Continue : LeafVisit::Stop;
+}
+
+template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
-                         Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf) {
+                         Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf,
+                         VisitRegionLeaf&& visit_region_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
@@ -110,20 +128,19 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           continue;
         }
         load_leaf(part, block, pose.tip_mm, leaf);
-        bool finite = false;
-        switch (cover.cover) {
-          case geometry::BoxCover::Region:
-          case geometry::BoxCover::RegionOrOutside:
-            finite = region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
-            break;
-          case geometry::BoxCover::SplitAtZ:
-            finite = split_leaf_contacts(tool, cover, leaf);
-            break;
-          case geometry::BoxCover::Outside:  // skipped above
-          case geometry::BoxCover::Mixed:
-            finite = mixed_leaf_contacts(tool, leaf);
-            break;
+        if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
+          switch (visit_region_leaf(cover, leaf)) {
+            case LeafVisit::Continue:
+              continue;
+            case LeafVisit::Stop:
+              return Walk::Stopped;
+            case LeafVisit::Fault:
+              break;
+          }
+          return Walk::BadTree;
         }
+        const bool finite = cover.cover == geometry::BoxCover::SplitAtZ ? split_leaf_contacts(tool, cover, leaf)
+                                                                        : mixed_leaf_contacts(tool, leaf);
         if (!finite) {
           return Walk::BadTree;
         }
@@ -216,7 +233,29 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     torque_sum += sums.torque;
     return true;
   };
-  const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf);
+  // A leaf in one region: its force in one pass over the lanes, and its deepest lane searched only
+  // when the box's bound says one of its points may be deeper than the deepest found so far.
+  const auto visit_region_leaf = [&](const geometry::BoxClassification& cover, const LeafContacts& leaf) {
+    RegionLeafForce settled{};
+    if (!region_leaf_force(part.tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
+                           cover.deepest_bound_mm > result.max_depth_mm, k_world, parameters.compliance_centre_mm, leaf,
+                           settled)) {
+      return LeafVisit::Fault;
+    }
+    if (settled.penetrating == 0) {
+      return LeafVisit::Continue;
+    }
+    result.penetrating_points += settled.penetrating;
+    if (settled.max_depth_mm > result.max_depth_mm) {
+      result.max_depth_mm = settled.max_depth_mm;
+      result.deepest_point = leaf.first + settled.deepest_lane;
+    }
+    force_sum += settled.sums.force;
+    torque_sum += settled.sums.torque;
+    return LeafVisit::Continue;
+  };
+  const Walk walk =
+      walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf, visit_region_leaf);
   if (walk == Walk::BadTree) {
     return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   }
@@ -233,12 +272,16 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
   if (!pose_is_usable(pose)) {
     return Legality::Fault;
   }
+  auto visit_leaf = [](const LeafContacts& leaf) { return leaf.penetrating == 0; };
   const Walk walk = walk_points_in_tool(
       part, part.tool, pose, Wanted::Penetrating,
       [](std::uint32_t, const geometry::PointClassification& c, const tables::LeafBlock&) {
         return c.contact != geometry::PointContact::Penetrating;
       },
-      [](const LeafContacts& leaf) { return leaf.penetrating == 0; });
+      visit_leaf,
+      [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
+        return settle_region_leaf(part.tool, cover, leaf, visit_leaf);
+      });
   switch (walk) {
     case Walk::Finished:
       return Legality::Legal;
@@ -257,19 +300,23 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
   }
   const std::size_t before = touched.count();
   const ToolPose inflated{pose.tip_mm - contact_tolerance_mm * pose.axis, pose.axis};
+  auto visit_leaf = [&](const LeafContacts& leaf) {
+    for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
+      if ((leaf.in_tool >> lane) & 1U) {
+        touched.insert(part.triangle_ids[leaf.first + lane]);
+      }
+    }
+    return true;
+  };
   static_cast<void>(walk_points_in_tool(
       part, contact_tool, inflated, Wanted::InTool,
       [&](std::uint32_t i, const geometry::PointClassification&, const tables::LeafBlock&) {
         touched.insert(part.triangle_ids[i]);
         return true;
       },
-      [&](const LeafContacts& leaf) {
-        for (std::uint32_t lane = 0; lane < leaf.count; ++lane) {
-          if ((leaf.in_tool >> lane) & 1U) {
-            touched.insert(part.triangle_ids[leaf.first + lane]);
-          }
-        }
-        return true;
+      visit_leaf,
+      [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
+        return settle_region_leaf(contact_tool, cover, leaf, visit_leaf);
       }));
   return static_cast<std::uint32_t>(touched.count() - before);
 }

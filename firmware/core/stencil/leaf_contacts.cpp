@@ -461,4 +461,195 @@ LeafForceSums leaf_forces(const LeafContacts& leaf, double k_world, double centr
           Eigen::Vector3d(double{lane_sum(tx)}, double{lane_sum(ty)}, double{lane_sum(tz)})};
 }
 
+namespace {
+
+#if defined(__AVX2__)
+// The fused pass of region_leaf_force: each step the same operation, on the same operands and in
+// the same order, as the loops of surface_contacts, summarise and leaf_forces (which the compiler
+// vectorises lane for lane, -ffp-contract=off), so the same bits; only nothing is stored between.
+__m256 splat(float value) { return _mm256_set1_ps(value); }
+
+// lane_sum's horizontal step, on partial sums already in a register.
+float reduce_sum(__m256 partial) {
+  const __m128 q = _mm_add_ps(_mm256_castps256_ps128(partial), _mm256_extractf128_ps(partial, 1));
+  const __m128 r = _mm_add_ps(q, _mm_movehl_ps(q, q));
+  return _mm_cvtss_f32(_mm_add_ss(r, _mm_shuffle_ps(r, r, 1)));
+}
+
+// The surface's function and the escape direction of eight lanes (surface_contacts' first loop).
+struct SurfaceLanes {
+  __m256 f, ex, ey, ez;
+};
+
+struct SurfaceConstants {
+  __m256 sign, centre_z, centre_r, radius;
+};
+
+// escape_to_world: radial along (x, y) / r, or along +y on the axis. std::max(r, k) is
+// _mm256_max_ps(k, r) (the second operand when they compare equal or r is NaN, as std::max).
+void escape_lanes(__m256 r, __m256 radial, __m256 axial, __m256 x, __m256 y, SurfaceLanes& s) {
+  const __m256 on_axis = _mm256_cmp_ps(r, splat(kOnAxisRadius_mm), _CMP_NGT_UQ);
+  const __m256 inverse = _mm256_div_ps(splat(1.0F), _mm256_max_ps(splat(kOnAxisRadius_mm), r));
+  s.ex = _mm256_blendv_ps(_mm256_mul_ps(radial, _mm256_mul_ps(x, inverse)), _mm256_setzero_ps(), on_axis);
+  s.ey = _mm256_blendv_ps(_mm256_mul_ps(radial, _mm256_mul_ps(y, inverse)), radial, on_axis);
+  s.ez = axial;
+}
+
+__m256 radius_lanes(__m256 x, __m256 y) { return _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y))); }
+
+template <SurfaceKind Kind>
+SurfaceLanes surface_lanes(const SurfaceConstants& c, __m256 x, __m256 y, __m256 z) {
+  SurfaceLanes s{};
+  if constexpr (Kind == SurfaceKind::PlaneZ) {
+    s.f = _mm256_sub_ps(z, c.centre_z);
+    s.ex = _mm256_setzero_ps();
+    s.ey = _mm256_setzero_ps();
+    s.ez = c.sign;
+  } else if constexpr (Kind == SurfaceKind::Cylinder) {
+    const __m256 r = radius_lanes(x, y);
+    s.f = _mm256_sub_ps(r, c.radius);
+    escape_lanes(r, c.sign, _mm256_setzero_ps(), x, y, s);
+  } else if constexpr (Kind == SurfaceKind::Sphere) {
+    const __m256 dz = _mm256_sub_ps(z, c.centre_z);
+    const __m256 length = _mm256_sqrt_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(dz, dz)));
+    s.f = _mm256_sub_ps(length, c.radius);
+    const __m256 degenerate = _mm256_cmp_ps(length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
+    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), length));
+    s.ex = _mm256_blendv_ps(_mm256_mul_ps(x, inverse), _mm256_setzero_ps(), degenerate);
+    s.ey = _mm256_blendv_ps(_mm256_mul_ps(y, inverse), splat(kInvSqrt2), degenerate);
+    s.ez = _mm256_blendv_ps(_mm256_mul_ps(dz, inverse), splat(-kInvSqrt2), degenerate);
+  } else {
+    const __m256 r = radius_lanes(x, y);
+    const __m256 dr = _mm256_sub_ps(r, c.centre_r);
+    const __m256 dz = _mm256_sub_ps(z, c.centre_z);
+    const __m256 length = _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(dr, dr), _mm256_mul_ps(dz, dz)));
+    s.f = _mm256_sub_ps(length, c.radius);
+    const __m256 degenerate = _mm256_cmp_ps(length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
+    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), length));
+    const __m256 radial = _mm256_blendv_ps(_mm256_mul_ps(dr, inverse), splat(kInvSqrt2), degenerate);
+    const __m256 axial = _mm256_blendv_ps(_mm256_mul_ps(dz, inverse), splat(-kInvSqrt2), degenerate);
+    escape_lanes(r, radial, axial, x, y, s);
+  }
+  return s;
+}
+
+template <SurfaceKind Kind>
+bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deepest, double k_world,
+                        double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
+  const float sign = surface.solid_side == geometry::SolidSide::Below ? 1.0F : -1.0F;
+  const SurfaceConstants c{splat(sign), splat(static_cast<float>(surface.center_z_mm)),
+                           splat(static_cast<float>(surface.center_r_mm)), splat(static_cast<float>(surface.radius_mm))};
+  const float band = band_for(leaf, surface);
+  const __m256 minus_sign = splat(-sign), tolerance = splat(kTolerance_mm), band_lanes = splat(band);
+  const __m256 no_sign = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
+  const __m256 k = splat(static_cast<float>(k_world)), height = splat(static_cast<float>(centre_height_mm));
+  const __m256 no_direction = splat(static_cast<float>(kNoDirection));
+  const __m256i count = _mm256_set1_epi32(static_cast<int>(leaf.count));
+  const LaneMask valid = lanes_below(leaf.count);
+  alignas(32) LeafLanes depths;
+  __m256 check = _mm256_setzero_ps();
+  __m256 fx_sum = _mm256_setzero_ps(), fy_sum = _mm256_setzero_ps(), fz_sum = _mm256_setzero_ps();
+  __m256 tx_sum = _mm256_setzero_ps(), ty_sum = _mm256_setzero_ps(), tz_sum = _mm256_setzero_ps();
+  LaneMask penetrating = 0;
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    const __m256 x = _mm256_load_ps(leaf.x.data() + base);
+    const __m256 y = _mm256_load_ps(leaf.y.data() + base);
+    const __m256 z = _mm256_load_ps(leaf.z.data() + base);
+    const SurfaceLanes s = surface_lanes<Kind>(c, x, y, z);
+    // surface_contacts' second loop: the verdicts, and the sum that tells a non-finite lane.
+    const __m256 depth = _mm256_mul_ps(minus_sign, s.f);
+    const __m256 deeper = _mm256_cmp_ps(depth, tolerance, _CMP_GT_OQ);
+    __m256 d = _mm256_and_ps(deeper, depth);
+    check = _mm256_add_ps(check, _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(s.f, s.ex), s.ey), s.ez));
+    penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
+    const LaneMask uncertain =
+        (static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(depth, no_sign), band_lanes, _CMP_LE_OQ)))
+         << base) & valid;
+    if (uncertain != 0) {
+      _mm256_store_ps(depths.data() + base, d);
+      for_each_lane(uncertain, [&](std::uint32_t lane) {
+        const double exact = exact_depth(leaf, lane, surface);
+        const bool is_deeper = exact > geometry::kSurfaceTolerance_mm;
+        depths[lane] = is_deeper ? static_cast<float>(exact) : 0.0F;
+        penetrating = is_deeper ? penetrating | (LaneMask{1} << lane) : penetrating & ~(LaneMask{1} << lane);
+      });
+      d = _mm256_load_ps(depths.data() + base);
+    }
+    // summarise: no depth past count.
+    const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+    d = _mm256_and_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(count, index)), d);
+    _mm256_store_ps(depths.data() + base, d);
+    // leaf_forces.
+    const __m256 vx = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nx + base), s.ex);
+    const __m256 vy = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->ny + base), s.ey);
+    const __m256 vz = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nz + base), s.ez);
+    const __m256 length = _mm256_sqrt_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(vx, vx), _mm256_mul_ps(vy, vy)), _mm256_mul_ps(vz, vz)));
+    const __m256 scale = _mm256_and_ps(_mm256_cmp_ps(length, no_direction, _CMP_GE_OQ),
+                                       _mm256_div_ps(_mm256_mul_ps(k, d), length));
+    const __m256 fx = _mm256_mul_ps(scale, vx), fy = _mm256_mul_ps(scale, vy), fz = _mm256_mul_ps(scale, vz);
+    const __m256 rz = _mm256_sub_ps(z, height);
+    fx_sum = _mm256_add_ps(fx_sum, fx);
+    fy_sum = _mm256_add_ps(fy_sum, fy);
+    fz_sum = _mm256_add_ps(fz_sum, fz);
+    tx_sum = _mm256_add_ps(tx_sum, _mm256_sub_ps(_mm256_mul_ps(y, fz), _mm256_mul_ps(rz, fy)));
+    ty_sum = _mm256_add_ps(ty_sum, _mm256_sub_ps(_mm256_mul_ps(rz, fx), _mm256_mul_ps(x, fz)));
+    tz_sum = _mm256_add_ps(tz_sum, _mm256_sub_ps(_mm256_mul_ps(x, fy), _mm256_mul_ps(y, fx)));
+  }
+  if (!std::isfinite(reduce_sum(check))) {
+    return false;
+  }
+  out.penetrating = static_cast<std::uint32_t>(std::popcount(penetrating & valid));
+  out.max_depth_mm = 0.0;
+  out.deepest_lane = 0;
+  if (find_deepest && out.penetrating > 0) {
+    const float floor = lane_max(depths) - 2.0F * band;
+    for_each_lane(penetrating & valid, [&](std::uint32_t lane) {
+      if (depths[lane] >= floor) {
+        const double depth = exact_depth(leaf, lane, surface);
+        if (depth > out.max_depth_mm) {
+          out.max_depth_mm = depth;
+          out.deepest_lane = lane;
+        }
+      }
+    });
+  }
+  out.sums = {Eigen::Vector3d(double{reduce_sum(fx_sum)}, double{reduce_sum(fy_sum)}, double{reduce_sum(fz_sum)}),
+              Eigen::Vector3d(double{reduce_sum(tx_sum)}, double{reduce_sum(ty_sum)}, double{reduce_sum(tz_sum)})};
+  return true;
+}
+#endif
+
+}  // namespace
+
+bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside, bool find_deepest,
+                       double k_world, double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
+#if defined(__AVX2__)
+  static_cast<void>(or_outside);  // only the touching lanes depend on it, and the force has none
+  switch (surface.kind) {
+    case SurfaceKind::PlaneZ:
+      return region_force_lanes<SurfaceKind::PlaneZ>(surface, find_deepest, k_world, centre_height_mm, leaf, out);
+    case SurfaceKind::Cylinder:
+      return region_force_lanes<SurfaceKind::Cylinder>(surface, find_deepest, k_world, centre_height_mm, leaf, out);
+    case SurfaceKind::Sphere:
+      return region_force_lanes<SurfaceKind::Sphere>(surface, find_deepest, k_world, centre_height_mm, leaf, out);
+    case SurfaceKind::Torus:
+      return region_force_lanes<SurfaceKind::Torus>(surface, find_deepest, k_world, centre_height_mm, leaf, out);
+  }
+  return false;
+#else
+  LeafContacts settled = leaf;
+  if (!region_leaf_contacts(tool, region, or_outside, settled)) {
+    return false;
+  }
+  out.penetrating = settled.penetrating;
+  out.max_depth_mm = find_deepest ? settled.max_depth_mm : 0.0;
+  out.deepest_lane = find_deepest ? settled.deepest_lane : 0;
+  out.sums = leaf_forces(settled, k_world, centre_height_mm);
+  return true;
+#endif
+}
+
 }  // namespace stencil::engine
