@@ -191,6 +191,10 @@ BoxClassification classify_meridian_box(const ToolBsp& tool, const MeridianBox& 
           above.part};
 }
 
+double region_deepest_bound(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box) {
+  return interior_range(tool.surfaces[tool.regions[region].surface], box).high;
+}
+
 MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
                                  const Eigen::Vector3d& high) {
   // Subtraction, squaring, addition and sqrt are each monotonic, so the nearest and farthest

@@ -52,6 +52,11 @@ struct BoxClassification {
 // point's rounded value falls outside its box's range. Allocation-free, at most node_count steps.
 [[nodiscard]] BoxClassification classify_meridian_box(const ToolBsp& tool, const MeridianBox& box);
 
+// No point of `box` is deeper than this inside the surface of region `region` (a region index of
+// the tree): the deepest_bound_mm classify_meridian_box gives a box it settles in that region, by
+// the same arithmetic. NaN when the surface's numbers are.
+[[nodiscard]] double region_deepest_bound(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box);
+
 // The meridian box that holds every point of the axis-aligned world box [low, high] as seen from
 // an upright tool (axis +z) with its tip at tip_mm, computed as the query computes each point's
 // r and z (local = point - tip, r = sqrt(x^2 + y^2)).

@@ -83,18 +83,39 @@ LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxC
   return visit_leaf(leaf) ? LeafVisit::Continue : LeafVisit::Stop;
 }
 
+// Below a node whose box the upright tool's tree settles in one region (Region), or in it or
+// outside (RegionOrOutside), every node is settled so too as far as penetrating points go: the
+// loader holds each node's DOP inside its parent's, so each point of the subtree either reaches
+// that region, its depth that of the region's surface, or is outside the tool, its depth there
+// below the tolerance. When only penetrating points are wanted, such a subtree is walked with the
+// region and each node's depth bound from that surface alone: no walk of the tool tree, no outline
+// test, the same verdicts, depths and forces. The touched set, which also wants the points on the
+// surface just outside, classifies each leaf itself.
+struct Pending {
+  std::uint32_t index;
+  geometry::BoxCover settled;  // Region or RegionOrOutside: settled by an ancestor; Mixed: not
+  std::uint8_t region;
+};
+
+// A leaf or node whose deepest point cannot be deeper than the tolerance (half of it, so that the
+// lanes' rounding cannot matter) has only touching points, which only the touched set wants.
+bool shallower_than_penetration(double deepest_bound_mm) {
+  return deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm;
+}
+
 template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
                          Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf,
                          VisitRegionLeaf&& visit_region_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
-  std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;
+  std::array<Pending, tables::kMaxTreeDepth + 1> stack;
   std::size_t size = 0;
-  stack[size++] = 0;
+  stack[size++] = {0, geometry::BoxCover::Mixed, 0};
   LeafContacts leaf;
   while (size > 0) {
-    const std::uint32_t index = stack[--size];
+    const Pending pending = stack[--size];
+    const std::uint32_t index = pending.index;
     if (index >= part.node_count()) {
       return Walk::BadTree;
     }
@@ -104,7 +125,16 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
     const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
-    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
+    const bool settled = pending.settled != geometry::BoxCover::Mixed;
+    geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
+    if (settled) {
+      const double bound =
+          geometry::region_deepest_bound(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
+      if (shallower_than_penetration(bound)) {
+        continue;
+      }
+      cover = {pending.settled, pending.region, bound, 0.0, {}, {}};
+    } else if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
     }
     if (node.point_count > 0) {
@@ -116,16 +146,13 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       }
       const tables::LeafBlock& block = part.leaves[node.leaf];
       if (upright) {
-        const geometry::BoxClassification cover =
-            geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
-        if (cover.cover == geometry::BoxCover::Outside) {
-          continue;
-        }
-        // No point of the leaf can be deeper than the tolerance (half of it, so that the lanes'
-        // rounding cannot matter): only touching points, which only the touched set wants.
-        if (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
-            cover.deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm) {
-          continue;
+        if (!settled) {
+          cover = geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+          if (cover.cover == geometry::BoxCover::Outside ||
+              (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
+               shallower_than_penetration(cover.deepest_bound_mm))) {
+            continue;
+          }
         }
         load_leaf(part, block, pose.tip_mm, leaf);
         if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
@@ -162,11 +189,24 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       }
       continue;
     }
+    Pending child{0, pending.settled, pending.region};
+    if (upright && wanted == Wanted::Penetrating && !settled) {
+      cover = geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+      if (cover.cover == geometry::BoxCover::Outside ||
+          (cover.cover != geometry::BoxCover::Mixed && shallower_than_penetration(cover.deepest_bound_mm))) {
+        continue;  // as each of its leaves would be
+      }
+      if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
+        child = {0, cover.cover, cover.region};
+      }
+    }
     if (size + 2 > stack.size()) {
       return Walk::BadTree;  // deeper than the loader allows: the tables were not loaded by it
     }
-    stack[size++] = node.right_child;
-    stack[size++] = index + 1;
+    child.index = node.right_child;
+    stack[size++] = child;
+    child.index = index + 1;
+    stack[size++] = child;
   }
   return Walk::Finished;
 }
@@ -176,8 +216,6 @@ Eigen::Vector3d normal_of(const tables::LeafBlock& block, std::uint32_t point) {
   const std::uint32_t lane = point - block.first_point;
   return {block.nx[lane], block.ny[lane], block.nz[lane]};
 }
-
-
 
 }  // namespace
 
