@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -13,6 +14,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include <unistd.h>
@@ -362,6 +364,21 @@ void print_row(const Options& options, const Row& row) {
   std::fflush(stdout);
 }
 
+// How much memory a table takes (it is locked in memory on the rig): one line per engine and size.
+void print_table_size(const Options& options, const char* impl, std::uint32_t points, std::uint32_t triangles,
+                      std::uintmax_t bytes) {
+  const double per_million = points > 0 ? static_cast<double>(bytes) / static_cast<double>(points) : 0.0;
+  if (options.json) {
+    std::printf("{\"points\": %u, \"triangles\": %u, \"impl\": \"%s\", \"what\": \"table\", \"bytes\": %ju, "
+                "\"mb_per_million_points\": %.2f}\n",
+                points, triangles, impl, bytes, per_million);
+  } else {
+    std::printf("%9u %-12s %-12s %-8s %10ju bytes: %.2f MB per million points\n", points, "-", impl, "table", bytes,
+                per_million);
+  }
+  std::fflush(stdout);
+}
+
 // The previous engine's rows for one state, from its own bench on its own table (same harness,
 // same machine, right after this engine's rows): its "stencil" rows, as impl "previous".
 std::vector<Row> previous_rows(const Options& options, const std::string& table, const State& state,
@@ -543,6 +560,8 @@ constexpr const char* kUsage =
     "engine's, alternately twice each; median_us is the faster run (--no-tablegen, --quick and\n"
     "--points leave it out).\n"
     "--table FILE: time this table (of the bench part) instead of generating one.\n"
+    "What \"table\": the bytes of this engine's table of the bench part and of the previous engine's,\n"
+    "and how many MB that is per million points (tables are locked in memory on the rig).\n"
     "--json: one JSON object per line.\n";
 
 // 0: parsed; otherwise the exit status (2 for a bad command line, 0 for --help).
@@ -668,6 +687,15 @@ int main(int argc, char** argv) {
                    options.previous_path.c_str());
       options.previous = false;
     }
+#if !defined(STENCIL_BENCH_PREVIOUS)
+    print_table_size(options, "stencil", part.point_count(), part.triangle_count(), bytes.size());
+    std::error_code size_error;
+    const std::uintmax_t previous_bytes = options.previous ? std::filesystem::file_size(previous_table, size_error) : 0;
+    if (options.previous && !size_error) {
+      // Of the same part, by the same point sampling: the same points.
+      print_table_size(options, "previous", part.point_count(), part.triangle_count(), previous_bytes);
+    }
+#endif
     std::vector<float> triangles(9 * part.triangle_count());
     std::memcpy(triangles.data(), part.triangles, triangles.size() * sizeof(float));
     const bench::FclReference fcl(triangles.data(), part.triangle_count());

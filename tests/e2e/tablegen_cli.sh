@@ -533,22 +533,26 @@ case_inspect_refuses_non_finite_point_with_a_valid_crc() {
 case_inspect_refuses_wrong_format_version() {
   make_table
   cp good.stbl version.stbl
-  put_u32 version.stbl 8 3
+  put_u32 version.stbl 8 4
   tablegen --inspect version.stbl
   expect_status 2
   expect_stderr_names_file version.stbl
   expect_stderr 'header\.format_version' "the field header.format_version"
 }
 
-# A table of format version 1 (before the packed leaves) is to be made again, in those words.
-case_inspect_of_a_version_1_table_says_regenerate() {
+# A table of format version 1 (before the packed leaves) or 2 (leaves of 32 points) is to be made
+# again, in those words.
+case_inspect_of_an_older_table_says_regenerate() {
   make_table
-  cp good.stbl old.stbl
-  put_u32 old.stbl 8 1
-  tablegen --inspect old.stbl
-  expect_status 2
-  expect_stderr_names_file old.stbl
-  expect_stderr 'format version 1: regenerate with stencil-tablegen' "format version 1: regenerate with stencil-tablegen"
+  for version in 1 2; do
+    cp good.stbl old.stbl
+    put_u32 old.stbl 8 "$version"
+    tablegen --inspect old.stbl
+    expect_status 2
+    expect_stderr_names_file old.stbl
+    expect_stderr "format version $version: regenerate with stencil-tablegen" \
+      "format version $version: regenerate with stencil-tablegen"
+  done
 }
 
 case_inspect_of_a_directory_is_refused() {

@@ -342,7 +342,7 @@ TEST(LeafContacts, TheOnePassForceOfALeafInOneRegionIsTheStepByStepOneBitForBit)
   }};
   std::uint32_t kinds_seen = 0;
   for (const auto& [centre, half] : leaves) {
-    for (const std::uint32_t count : {32U, 13U}) {
+    for (const std::uint32_t count : {tables::kMaxLeafPoints, 32U, 13U}) {
       const LeafPoints points(centre, half, count);
       const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
       CHECK_TEXT(cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside,

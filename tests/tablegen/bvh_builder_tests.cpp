@@ -68,18 +68,20 @@ bool dop_holds(const tables::BvhNode& node, const tables::PackedPoint& p) {
 TEST_GROUP(BvhBuilder){};
 
 TEST(BvhBuilder, TheLeftChildTakesHalfItsLeavesWorth) {
-  CHECK_EQUAL(32U, point_tree_left_count(33));
-  CHECK_EQUAL(32U, point_tree_left_count(64));
-  CHECK_EQUAL(32U, point_tree_left_count(96));  // three leaves: one left, two right
-  CHECK_EQUAL(64U, point_tree_left_count(97));  // four leaves: two and two
+  constexpr std::uint32_t L = tables::kMaxLeafPoints;
+  CHECK_EQUAL(L, point_tree_left_count(L + 1));
+  CHECK_EQUAL(L, point_tree_left_count(2 * L));
+  CHECK_EQUAL(L, point_tree_left_count(3 * L));          // three leaves: one left, two right
+  CHECK_EQUAL(2 * L, point_tree_left_count(3 * L + 1));  // four leaves: two and two
 }
 
 TEST(BvhBuilder, NodeCountsFollowTheSplit) {
+  constexpr std::uint32_t L = tables::kMaxLeafPoints;
   CHECK_EQUAL(1U, point_tree_node_count(1));
-  CHECK_EQUAL(1U, point_tree_node_count(32));
-  CHECK_EQUAL(3U, point_tree_node_count(33));
-  CHECK_EQUAL(5U, point_tree_node_count(96));
-  CHECK_EQUAL(7U, point_tree_node_count(128));
+  CHECK_EQUAL(1U, point_tree_node_count(L));
+  CHECK_EQUAL(3U, point_tree_node_count(L + 1));
+  CHECK_EQUAL(5U, point_tree_node_count(3 * L));
+  CHECK_EQUAL(7U, point_tree_node_count(4 * L));
 }
 
 TEST(BvhBuilder, EveryPointIsInOneFullLeafAndInsideEveryDopAboveIt) {
@@ -91,12 +93,13 @@ TEST(BvhBuilder, EveryPointIsInOneFullLeafAndInsideEveryDopAboveIt) {
   std::vector<std::uint32_t> leaf_sizes;
   CHECK_EQUAL(1000U, check_subtree(tree, 0, seen, leaf_sizes));
   CHECK(std::all_of(seen.begin(), seen.end(), [](int n) { return n == 1; }));
-  // Leaves in depth-first order: all full but the last (1000 = 31 * 32 + 8).
-  CHECK_EQUAL(32U, leaf_sizes.size());
+  // Leaves in depth-first order: all full but the last (1000 = 15 * 64 + 40).
+  static_assert(tables::kMaxLeafPoints == 64, "the counts below are for leaves of 64 points");
+  CHECK_EQUAL(16U, leaf_sizes.size());
   for (std::size_t i = 0; i + 1 < leaf_sizes.size(); ++i) {
     CHECK_EQUAL(tables::kMaxLeafPoints, leaf_sizes[i]);
   }
-  CHECK_EQUAL(8U, leaf_sizes.back());
+  CHECK_EQUAL(40U, leaf_sizes.back());
   // The root's DOP holds every point; each leaf's DOP holds its own.
   for (const tables::PackedPoint& p : points) {
     CHECK(dop_holds(tree.nodes[0], p));
@@ -109,16 +112,18 @@ TEST(BvhBuilder, EveryPointIsInOneFullLeafAndInsideEveryDopAboveIt) {
 }
 
 TEST(BvhBuilder, TheLowerHalfAlongTheWidestSlabGoesLeft) {
-  // 64 points along x only: the root splits them at x's median, the lower 32 to the left.
+  // Two leaves' worth of points along x only: the root splits them at x's median, the lower
+  // half to the left.
+  constexpr int kCount = 2 * static_cast<int>(tables::kMaxLeafPoints);
   std::vector<tables::PackedPoint> points;
-  for (int i = 63; i >= 0; --i) {
+  for (int i = kCount - 1; i >= 0; --i) {
     points.push_back({static_cast<float>(i), 0.0f, 0.0f});
   }
   const PointTree tree = build_point_tree(points, 1);
   CHECK_EQUAL(3U, tree.nodes.size());
   const tables::BvhNode& left = tree.nodes[1];
   for (std::uint32_t slot = left.first_point; slot < left.first_point + left.point_count; ++slot) {
-    CHECK(points[tree.order[slot]].x_mm < 32.0f);
+    CHECK(points[tree.order[slot]].x_mm < static_cast<float>(kCount / 2));
   }
 }
 

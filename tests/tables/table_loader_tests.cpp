@@ -134,7 +134,7 @@ TEST(TableLoader, RefusesTheWrongMagicVersionOrHeaderSize) {
 
   bytes = copy_of(valid_table(), valid_table().size());
   TableHeader header = header_of(bytes);
-  header.format_version = 3;
+  header.format_version = kTableFormatVersion + 1;
   put_header(bytes, header);
   reseal(bytes);
   check_refused(bytes, "header.format_version");
@@ -152,6 +152,14 @@ TEST(TableLoader, RefusesTheWrongMagicVersionOrHeaderSize) {
   STRCMP_EQUAL("header.format_version", older.field);
   CHECK(older.expected == kOlderVersion);
   DOUBLES_EQUAL(1.0, older.value, 0.0);
+  // And one of leaves of 32 points, the format before this one.
+  header.format_version = kTableFormatVersion - 1;
+  put_header(bytes, header);
+  reseal(bytes);
+  const TableLoadResult previous = load(bytes, tables);
+  CHECK_FALSE(previous.ok);
+  CHECK(previous.expected == kOlderVersion);
+  DOUBLES_EQUAL(2.0, previous.value, 0.0);
 
   bytes = copy_of(valid_table(), valid_table().size());
   header = header_of(bytes);
@@ -254,7 +262,8 @@ TEST(TableLoader, RefusesAMalformedTree) {
   with_nodes([](BvhNode* n, std::uint32_t count) { n[0].right_child = count; }, "nodes.right_child");
   with_nodes([](BvhNode* n, std::uint32_t) { n[0].right_child = 1; }, "nodes.right_child");
   with_nodes([&](BvhNode* n, std::uint32_t count) { n[first_leaf(n, count)].first_point += 1; }, "nodes.leaf");
-  with_nodes([&](BvhNode* n, std::uint32_t count) { n[first_leaf(n, count)].point_count = 33; }, "nodes.leaf");
+  with_nodes([&](BvhNode* n, std::uint32_t count) { n[first_leaf(n, count)].point_count = kMaxLeafPoints + 1; },
+             "nodes.leaf");
   with_nodes([&](BvhNode* n, std::uint32_t count) { n[first_leaf(n, count)].dop_max[0] -= 0.5; }, "nodes.dop");
   with_nodes([](BvhNode* n, std::uint32_t) { n[1].dop_max[2] = n[0].dop_max[2] + 1.0; }, "nodes.dop");
   with_nodes([](BvhNode* n, std::uint32_t) { n[0].dop_min[3] = std::numeric_limits<double>::quiet_NaN(); },

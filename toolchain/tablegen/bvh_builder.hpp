@@ -16,7 +16,7 @@ struct PointTree {
 // Splits along the slab of largest extent (ties broken by input index, so the result is
 // deterministic) until a node has at most kMaxLeafPoints points, at the whole leaf nearest the
 // median (point_tree_left_count): every leaf but the last holds kMaxLeafPoints points, so the
-// query's 32-lane kernels run full and a tree has as few nodes as it can. The two halves of the
+// query's 64-lane kernels run full and a tree has as few nodes as it can. The two halves of the
 // root are built on two threads when threads > 1; the result does not depend on `threads`.
 // The DOPs are computed from `points` exactly as given (the float values the table will hold).
 [[nodiscard]] PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsigned threads);

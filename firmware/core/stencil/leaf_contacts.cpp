@@ -23,7 +23,7 @@ constexpr float kDegenerateDistance_mm = 1e-12F;
 constexpr float kInvSqrt2 = 0.70710678F;
 constexpr float kTolerance_mm = static_cast<float>(geometry::kSurfaceTolerance_mm);
 
-// The loops below are plain loops over the 32 lanes, which the compiler vectorises (selects become
+// The loops below are plain loops over the leaf's lanes, which the compiler vectorises (selects become
 // blends); sums and maxima are taken in a fixed order of eight partial lanes, since the compiler
 // may not reorder a floating-point reduction itself. The same binary gives the same bits.
 constexpr std::uint32_t kPartials = 8;
@@ -53,8 +53,10 @@ float lane_sum(const LeafLanes& a) {
 // maximum is exact, so the order of the comparisons cannot change it.
 float lane_max(const LeafLanes& a) {
 #if defined(__AVX2__)
-  const __m256 m = _mm256_max_ps(_mm256_max_ps(_mm256_loadu_ps(a.data()), _mm256_loadu_ps(a.data() + 8)),
-                                 _mm256_max_ps(_mm256_loadu_ps(a.data() + 16), _mm256_loadu_ps(a.data() + 24)));
+  __m256 m = _mm256_loadu_ps(a.data());
+  for (std::uint32_t base = 8; base < kLanes; base += 8) {
+    m = _mm256_max_ps(m, _mm256_loadu_ps(a.data() + base));
+  }
   const __m128 q = _mm_max_ps(_mm256_castps256_ps128(m), _mm256_extractf128_ps(m, 1));
   const __m128 r = _mm_max_ps(q, _mm_movehl_ps(q, q));
   return _mm_cvtss_f32(_mm_max_ss(r, _mm_shuffle_ps(r, r, 1)));

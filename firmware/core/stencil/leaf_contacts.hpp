@@ -25,8 +25,8 @@ namespace stencil::engine {
 // the double-precision classification. Only the force and torque sums carry the float rounding
 // (relative error about 1e-6, far below anything the operator can feel).
 using LeafLanes = std::array<float, tables::kMaxLeafPoints>;
-using LaneMask = std::uint32_t;  // bit i for lane i
-static_assert(tables::kMaxLeafPoints <= 32, "a lane mask holds every lane of a leaf");
+using LaneMask = std::uint64_t;  // bit i for lane i
+static_assert(tables::kMaxLeafPoints <= 64, "a lane mask holds every lane of a leaf");
 
 // Below this length a point's normal and the tool's escape direction cancel: the point gives no
 // force direction (the same threshold for the per-point path of the query and the lanes).
@@ -34,7 +34,7 @@ inline constexpr double kNoDirection = 1e-12;
 
 struct LeafContacts {
   std::uint32_t first;                // table index of the leaf's first point
-  std::uint32_t count;                // its points (1 to 32); lanes past count repeat the last point
+  std::uint32_t count;                // its points (1 to kMaxLeafPoints); lanes past count repeat the last point
   const tables::PackedPoint* points;  // the leaf's points in the tables, for the double-precision checks
   Eigen::Vector3d tip_mm;             // the tool's tip the offsets are taken from
   float magnitude_mm;                 // no lane's |x| + |y| + |z| is larger

@@ -22,7 +22,7 @@ TableLoadResult ok() { return {true, nullptr, nullptr, 0, 0.0}; }
 
 }  // namespace
 
-const char* const kOlderVersion = "format version 2 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
+const char* const kOlderVersion = "format version 3 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
 
 namespace {
 
@@ -84,11 +84,11 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
   }
   if (header.format_version != kTableFormatVersion) {
     // Earlier versions are tables this build could read once: they are to be made again, not repaired.
-    static_assert(kTableFormatVersion == 2, "the texts below name the version");
+    static_assert(kTableFormatVersion == 3, "the texts below name the version");
     return refuse("header.format_version",
                   header.format_version >= 1 && header.format_version < kTableFormatVersion
                       ? kOlderVersion
-                      : "format version 2 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
+                      : "format version 3 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
                   8, header.format_version);
   }
   if (header.header_bytes != sizeof(TableHeader)) {
@@ -308,7 +308,7 @@ TableLoadResult check_tree(const PartTables& tables) {
     if (node.point_count > 0) {
       if (node.point_count > kMaxLeafPoints || node.first_point != next_point ||
           node.point_count > tables.point_count() - next_point) {
-        return refuse("nodes.leaf", "the next run of at most 32 points", pending.node, node.first_point);
+        return refuse("nodes.leaf", "the next run of at most 64 points", pending.node, node.first_point);
       }
       for (std::uint32_t i = node.first_point; i < node.first_point + node.point_count; ++i) {
         if (!dop_holds_point(node, tables.points[i])) {
