@@ -200,3 +200,48 @@ TEST(MeridianBox, TheUprightBoxHoldsEveryPointsRadiusAndHeight) {
     DOUBLES_EQUAL(std::sqrt(near_local.x() * near_local.x() + near_local.y() * near_local.y()), box.r_low_mm, 1e-12);
   }
 }
+
+// The query keeps a settled box's region for every box inside it (the points' tree below a
+// settled node): each such box that is not wholly outside is settled in that same region, Region
+// below Region, and region_deepest_bound gives it the bound its own classification would.
+TEST(MeridianBox, ABoxInsideASettledOneIsSettledInTheSameRegionWithTheSameBound) {
+  std::mt19937_64 random(30);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (const auto& sample : kSampleTools) {
+    ToolBsp tool{};
+    CHECK(build_tool_bsp(sample.spec, tool).ok);
+    const double reach = 1.2 * tool.envelope.holder_radius_mm;
+    const double height = 1.1 * tool.envelope.total_length_mm;
+    int inner_settled = 0;
+    for (int i = 0; i < 4000; ++i) {
+      const double size = std::pow(10.0, -2.0 + 2.5 * unit(random));
+      const double r = reach * unit(random);
+      const double z = -0.05 * height + height * unit(random);
+      const MeridianBox box{r, r + size * unit(random), z, z + size * unit(random)};
+      const BoxClassification outer = classify_meridian_box(tool, box);
+      if (outer.cover != BoxCover::Region && outer.cover != BoxCover::RegionOrOutside) {
+        continue;
+      }
+      DOUBLES_EQUAL(outer.deepest_bound_mm, region_deepest_bound(tool, outer.region, box), 0.0);
+      for (int j = 0; j < 4; ++j) {
+        const double r_low = box.r_low_mm + (box.r_high_mm - box.r_low_mm) * unit(random);
+        const double z_low = box.z_low_mm + (box.z_high_mm - box.z_low_mm) * unit(random);
+        const MeridianBox inner{r_low, r_low + (box.r_high_mm - r_low) * unit(random), z_low,
+                                z_low + (box.z_high_mm - z_low) * unit(random)};
+        const BoxClassification own = classify_meridian_box(tool, inner);
+        CHECK(own.cover != BoxCover::Mixed && own.cover != BoxCover::SplitAtZ);
+        if (outer.cover == BoxCover::Region) {
+          CHECK(own.cover == BoxCover::Region);
+        }
+        if (own.cover == BoxCover::Outside) {
+          continue;
+        }
+        ++inner_settled;
+        LONGS_EQUAL(outer.region, own.region);
+        DOUBLES_EQUAL(own.deepest_bound_mm, region_deepest_bound(tool, outer.region, inner), 0.0);
+        CHECK(own.deepest_bound_mm <= outer.deepest_bound_mm);
+      }
+    }
+    CHECK_TEXT(inner_settled > 1000, sample.name);
+  }
+}
