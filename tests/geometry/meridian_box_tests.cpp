@@ -74,27 +74,37 @@ void check_box(const ToolBsp& tool, const MeridianBox& box, std::mt19937_64& ran
   }
 }
 
+// A box of the meridian plane somewhere over the tool (out past the holder's side, from just
+// below the tip to past its top), its size 10^(low_exponent + up to `decades`) mm.
+struct RandomBox {
+  MeridianBox box;
+  double size;
+};
+RandomBox random_box(const ToolBsp& tool, std::mt19937_64& random, double low_exponent, double decades) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const double reach = 1.2 * tool.envelope.holder_radius_mm;
+  const double height = 1.1 * tool.envelope.total_length_mm;
+  const double size = std::pow(10.0, low_exponent + decades * unit(random));
+  const double r = reach * unit(random);
+  const double z = -0.05 * height + height * unit(random);
+  return {{r, r + size * unit(random), z, z + size * unit(random)}, size};
+}
+
 }  // namespace
 
 TEST_GROUP(MeridianBox){};
 
 TEST(MeridianBox, EverySettledBoxAgreesWithEachOfItsPointsAndSmallBoxesAreMostlySettled) {
   std::mt19937_64 random(2026);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   for (const auto& sample : kSampleTools) {
     ToolBsp tool{};
     CHECK(build_tool_bsp(sample.spec, tool).ok);
-    const double reach = 1.2 * tool.envelope.holder_radius_mm;
-    const double height = 1.1 * tool.envelope.total_length_mm;
     Tally small;
     Tally large;
     for (int i = 0; i < 4000; ++i) {
       // Sizes from a micrometre to a few millimetres, like leaves of fine and coarse tables.
-      const double size = std::pow(10.0, -3.0 + 3.5 * unit(random));
-      const double r = reach * unit(random);
-      const double z = -0.05 * height + height * unit(random);
-      const MeridianBox box{r, r + size * unit(random), z, z + size * unit(random)};
-      check_box(tool, box, random, size < 0.2 ? small : large);
+      const RandomBox sampled = random_box(tool, random, -3.0, 3.5);
+      check_box(tool, sampled.box, random, sampled.size < 0.2 ? small : large);
     }
     // Boxes of a leaf's size (well under the tool's features) rarely straddle two tests at once.
     CHECK_TEXT(small.settled > 19 * small.boxes / 20, sample.name);
@@ -210,14 +220,9 @@ TEST(MeridianBox, ABoxInsideASettledOneIsSettledInTheSameRegionWithTheSameBound)
   for (const auto& sample : kSampleTools) {
     ToolBsp tool{};
     CHECK(build_tool_bsp(sample.spec, tool).ok);
-    const double reach = 1.2 * tool.envelope.holder_radius_mm;
-    const double height = 1.1 * tool.envelope.total_length_mm;
     int inner_settled = 0;
     for (int i = 0; i < 4000; ++i) {
-      const double size = std::pow(10.0, -2.0 + 2.5 * unit(random));
-      const double r = reach * unit(random);
-      const double z = -0.05 * height + height * unit(random);
-      const MeridianBox box{r, r + size * unit(random), z, z + size * unit(random)};
+      const MeridianBox box = random_box(tool, random, -2.0, 2.5).box;
       const BoxClassification outer = classify_meridian_box(tool, box);
       if (outer.cover != BoxCover::Region && outer.cover != BoxCover::RegionOrOutside) {
         continue;
