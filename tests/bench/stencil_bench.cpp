@@ -518,13 +518,16 @@ void tablegen_rows(const Options& options, const std::string& scratch) {
   std::vector<double> seconds[2];
   for (int round = 0; round < kRounds; ++round) {
     for (int which = 0; which < 2; ++which) {
-      // Its warnings (the bench part is an open mesh, with no allowance) are known: left out.
+      // Its warnings (the bench part is an open mesh, with no allowance) are known: kept in a file,
+      // shown only when it fails.
+      const std::string messages = scratch + "/tablegen.stderr";
       const std::string command = shell_quoted(which == 0 ? here : before) + " " + shell_quoted(stl) +
                                   " --tool ball:d=3 --spacing 50 --force --quiet -o " +
-                                  shell_quoted(scratch + "/million.stbl") + " 2> /dev/null";
+                                  shell_quoted(scratch + "/million.stbl") + " 2> " + shell_quoted(messages);
       const auto begin = Clock::now();
       if (std::system(command.c_str()) != 0) {
-        std::fprintf(stderr, "stencil-bench: %s failed\n", command.c_str());
+        std::fprintf(stderr, "stencil-bench: %s failed:\n", command.c_str());
+        static_cast<void>(std::system(("cat " + shell_quoted(messages) + " >&2").c_str()));
         return;
       }
       seconds[which].push_back(std::chrono::duration<double>(Clock::now() - begin).count());

@@ -239,6 +239,9 @@ TEST(MeridianBox, ABoxInsideASettledOneIsSettledInTheSameRegionWithTheSameBound)
           CHECK(own.cover == BoxCover::Region);
         }
         if (own.cover == BoxCover::Outside) {
+          // Below a RegionOrOutside box: no point of it reaches the region's surface, so the walk
+          // that keeps the region culls it by its bound, as it culls an Outside leaf.
+          CHECK(region_deepest_bound(tool, outer.region, inner) < -kSurfaceTolerance_mm);
           continue;
         }
         ++inner_settled;

@@ -328,6 +328,31 @@ TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
   DOUBLES_EQUAL(0.0, up.force.head<2>().norm(), 1e-7);
 }
 
+namespace {
+
+// region_leaf_force against region_leaf_contacts then leaf_forces, on the leaf as loaded: the same
+// count, deepest lane and depth (when searched) and the same bits of force and torque.
+void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                                    const LeafContacts& loaded) {
+  const bool or_outside = cover.cover == geometry::BoxCover::RegionOrOutside;
+  LeafContacts step_by_step = loaded;
+  CHECK(region_leaf_contacts(tool, cover.region, or_outside, step_by_step));
+  const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
+  CHECK(step_by_step.penetrating > 0);
+  for (const bool find_deepest : {true, false}) {
+    LeafContacts leaf = loaded;
+    RegionLeafForce one_pass{};
+    CHECK(region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
+    LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
+    DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
+    LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
+    CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
+    CHECK(sums.torque == one_pass.sums.torque);
+  }
+}
+
+}  // namespace
+
 TEST(LeafContacts, TheOnePassForceOfALeafInOneRegionIsTheStepByStepOneBitForBit) {
   // Leaves in the ball, by the flutes' side, under the holder's step, by its concave edge, and
   // across the ball's surface: every kind of surface a region can have.
@@ -347,25 +372,57 @@ TEST(LeafContacts, TheOnePassForceOfALeafInOneRegionIsTheStepByStepOneBitForBit)
       const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
       CHECK_TEXT(cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside,
                  "each leaf lies in one region, or in it or outside");
-      const bool or_outside = cover.cover == geometry::BoxCover::RegionOrOutside;
       kinds_seen |= 1U << static_cast<unsigned>(tool.surfaces[tool.regions[cover.region].surface].kind);
       load_leaf(points.part, points.packed(), kTip, leaf);
-      for (const bool find_deepest : {true, false}) {
-        RegionLeafForce one_pass{};
-        CHECK(region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
-        LeafContacts step_by_step = leaf;
-        CHECK(region_leaf_contacts(tool, cover.region, or_outside, step_by_step));
-        const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
-        LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
-        CHECK(one_pass.penetrating > 0);
-        DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
-        LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
-        CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
-        CHECK(sums.torque == one_pass.sums.torque);
-      }
+      check_one_pass_is_step_by_step(tool, cover, leaf);
     }
   }
   LONGS_EQUAL(0xF, kinds_seen);  // plane, cylinder, sphere and torus
+}
+
+TEST(LeafContacts, TheOnePassForceSettlesLanesOnTheSurfaceInDoublePrecisionAsTheStepsDo) {
+  // Points on the ball's surface, to a float's rounding: their float depths are within the band,
+  // so each is settled again in double precision, in the one pass as in the steps.
+  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
+  const Eigen::Vector3d centre(0.0, 0.0, 1.5);
+  std::uint32_t on_the_surface = 0;
+  for (std::uint32_t i = 0; i < points.count; ++i) {
+    const double t = static_cast<double>(i);
+    const double polar = 2.0 + 0.4 * std::sin(1.3 * t);  // below the equator, away from the tip
+    const double azimuth = 0.3 * std::cos(0.7 * t);
+    const Eigen::Vector3d p =
+        kTip + centre + 1.5 * Eigen::Vector3d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
+                                              std::cos(polar));
+    points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    const geometry::PointClassification c =
+        geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(i));
+    const double depth = c.contact == geometry::PointContact::Outside ? -1.0 : c.depth_mm;
+    on_the_surface += std::abs(depth) < 3e-6 || c.contact == geometry::PointContact::Touching ? 1U : 0U;
+  }
+  CHECK_TEXT(on_the_surface > 8, "points within the lanes' band of the surface");
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::RegionOrOutside);
+  load_leaf(points.part, points.packed(), kTip, leaf);
+  check_one_pass_is_step_by_step(tool, cover, leaf);
+  LeafContacts settled = leaf;
+  CHECK(region_leaf_contacts(tool, cover.region, true, settled));
+  check_against_the_tree(tool, points, settled);
+}
+
+TEST(LeafContacts, EveryLaneOfAFullLeafIsSettledAsTheTreeSettlesItsPoint) {
+  // The lanes past 32 too: a leaf of kMaxLeafPoints points each way a leaf is settled.
+  check_leaf(LeafPoints(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), tables::kMaxLeafPoints),
+             geometry::BoxCover::Region);
+  LONGS_EQUAL(tables::kMaxLeafPoints, leaf.penetrating);
+  check_leaf(LeafPoints(Eigen::Vector3d(0.1, 0.0, 0.0), Eigen::Vector3d(0.05, 0.05, 0.02), tables::kMaxLeafPoints),
+             geometry::BoxCover::RegionOrOutside);
+  check_leaf(LeafPoints(Eigen::Vector3d(1.3, 0.0, 1.5), Eigen::Vector3d(0.05, 0.05, 0.1), tables::kMaxLeafPoints),
+             geometry::BoxCover::SplitAtZ);
+  const LeafPoints mixed(Eigen::Vector3d(0.8, 0.0, 1.2), Eigen::Vector3d(1.0, 1.0, 1.0), tables::kMaxLeafPoints);
+  load_leaf(mixed.part, mixed.packed(), kTip, leaf);
+  CHECK(mixed_leaf_contacts(tool, leaf));
+  const std::uint32_t penetrating = check_against_the_tree(tool, mixed, leaf);
+  CHECK(penetrating > 0 && penetrating < tables::kMaxLeafPoints);
 }
 
 TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {

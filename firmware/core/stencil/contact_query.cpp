@@ -53,14 +53,14 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 
 // Walks the points' tree for the tool at `pose`. Leaves are culled by the tool's 14-DOP and, for
 // the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
-// end). For the upright tool each remaining leaf goes to visit_leaf as a whole, its points' depths
-// and escape directions computed lane-wise: from one region's surface when the leaf's box lies in
-// that region or just straddles its boundary (no walk of the tool tree per point), from the two
-// sides' regions when it straddles a partition plane, point by point through the tool tree when
-// it straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it
-// or outside) goes loaded to visit_region_leaf(cover, leaf), which settles its lanes itself (the
-// query computes its force in the same pass) and answers a LeafVisit; the others go settled to
-// visit_leaf. For any other axis each point goes through classify_at_pose and
+// end). For the upright tool each remaining leaf is taken as a whole, its points' depths and
+// escape directions computed lane-wise: from one region's surface when the leaf's box lies in that
+// region or just straddles its boundary (no walk of the tool tree per point), from the two sides'
+// regions when it straddles a partition plane, point by point through the tool tree when it
+// straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it or
+// outside) goes loaded to visit_region_leaf(cover, leaf), which settles its lanes itself (the
+// query computes its force in the same pass) and answers a LeafVisit; the split and mixed ones go
+// settled to visit_leaf. For any other axis each point goes through classify_at_pose and
 // visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
 // block, for its normal). visit_point and visit_leaf stop the walk by returning false. Iterative,
 // with a fixed stack as deep as the loader allows trees to be.
@@ -90,7 +90,8 @@ LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxC
 // below the tolerance. When only penetrating points are wanted, such a subtree is walked with the
 // region and each node's depth bound from that surface alone: no walk of the tool tree, no outline
 // test, the same verdicts, depths and forces. The touched set, which also wants the points on the
-// surface just outside, classifies each leaf itself.
+// surface just outside, classifies each leaf itself. This rests on the loader's check of the DOPs
+// (nodes.dop, "inside its parent's DOP"): tables that did not pass the loader get no such promise.
 struct Pending {
   std::uint32_t index;
   geometry::BoxCover settled;  // Region or RegionOrOutside: settled by an ancestor; Mixed: not
@@ -273,7 +274,7 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   };
   // A leaf in one region: its force in one pass over the lanes, and its deepest lane searched only
   // when the box's bound says one of its points may be deeper than the deepest found so far.
-  const auto visit_region_leaf = [&](const geometry::BoxClassification& cover, const LeafContacts& leaf) {
+  const auto visit_region_leaf = [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
     RegionLeafForce settled{};
     if (!region_leaf_force(part.tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
                            cover.deepest_bound_mm > result.max_depth_mm, k_world, parameters.compliance_centre_mm, leaf,

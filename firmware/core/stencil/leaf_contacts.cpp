@@ -23,9 +23,10 @@ constexpr float kDegenerateDistance_mm = 1e-12F;
 constexpr float kInvSqrt2 = 0.70710678F;
 constexpr float kTolerance_mm = static_cast<float>(geometry::kSurfaceTolerance_mm);
 
-// The loops below are plain loops over the leaf's lanes, which the compiler vectorises (selects become
-// blends); sums and maxima are taken in a fixed order of eight partial lanes, since the compiler
-// may not reorder a floating-point reduction itself. The same binary gives the same bits.
+// The loops below are plain loops over the leaf's lanes, which the compiler vectorises (selects
+// become blends); sums and maxima are taken in a fixed order of eight partial lanes, since the
+// compiler may not reorder a floating-point reduction itself. The same binary gives the same bits.
+// region_leaf_force's fused pass does the same operations in AVX2 registers, in the same order.
 constexpr std::uint32_t kPartials = 8;
 
 float lane_sum(const LeafLanes& a) {
@@ -440,8 +441,9 @@ LeafForceSums leaf_forces(const LeafContacts& leaf, double k_world, double centr
   const auto k = static_cast<float>(k_world);
   const auto height = static_cast<float>(centre_height_mm);
   constexpr auto kNoDirectionF = static_cast<float>(kNoDirection);
-  // Left to the compiler's vectoriser: an AVX2 version of this loop, the six sums kept in registers,
-  // took more instructions (81,977 against 75,117 per deep-corner query at 1e6 points, callgrind).
+  // Left to the compiler's vectoriser (an AVX2 version of this loop alone took more instructions);
+  // the query's leaves in one region take region_leaf_force's fused pass instead, which saves the
+  // stores between the steps.
   LeafLanes fx, fy, fz, tx, ty, tz;
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
     const float vx = leaf.normals->nx[lane] - leaf.ex[lane];
@@ -626,7 +628,7 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
 }  // namespace
 
 bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside, bool find_deepest,
-                       double k_world, double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
+                       double k_world, double centre_height_mm, LeafContacts& leaf, RegionLeafForce& out) {
   const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
 #if defined(__AVX2__)
   static_cast<void>(or_outside);  // only the touching lanes depend on it, and the force has none
@@ -642,14 +644,16 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
   }
   return false;
 #else
-  LeafContacts settled = leaf;
-  if (!region_leaf_contacts(tool, region, or_outside, settled)) {
+  // The rig's baseline build (x86-64-v2): the two steps on the walk's own leaf, as before the
+  // fused pass (its deepest lane is searched either way; the answer is the same).
+  static_cast<void>(surface);
+  if (!region_leaf_contacts(tool, region, or_outside, leaf)) {
     return false;
   }
-  out.penetrating = settled.penetrating;
-  out.max_depth_mm = find_deepest ? settled.max_depth_mm : 0.0;
-  out.deepest_lane = find_deepest ? settled.deepest_lane : 0;
-  out.sums = leaf_forces(settled, k_world, centre_height_mm);
+  out.penetrating = leaf.penetrating;
+  out.max_depth_mm = find_deepest ? leaf.max_depth_mm : 0.0;
+  out.deepest_lane = find_deepest ? leaf.deepest_lane : 0;
+  out.sums = leaf_forces(leaf, k_world, centre_height_mm);
   return true;
 #endif
 }

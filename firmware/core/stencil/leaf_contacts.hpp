@@ -88,9 +88,10 @@ struct LeafForceSums {
 
 // region_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (loaded by
 // load_leaf) lies in region `region` of the upright tool, or in it or outside (`or_outside`). The
-// same numbers, bit for bit, with nothing stored between the steps. The deepest lane is searched
-// only when `find_deepest` (the caller knows no lane can beat what it has otherwise); max_depth_mm
-// is 0 when it is not. False on a non-finite result.
+// same numbers, bit for bit, with nothing stored between the steps (with AVX2; without it, the two
+// steps themselves, the leaf settled in place). The deepest lane is searched only when
+// `find_deepest` (the caller knows no lane can beat what it has otherwise); max_depth_mm is 0 when
+// it is not. False on a non-finite result.
 struct RegionLeafForce {
   std::uint32_t penetrating;   // lanes deeper than the tolerance (double-precision verdict)
   double max_depth_mm;         // the deepest lane's depth, when searched and some lane penetrates
@@ -99,6 +100,6 @@ struct RegionLeafForce {
 };
 [[nodiscard]] bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside,
                                      bool find_deepest, double k_world, double centre_height_mm,
-                                     const LeafContacts& leaf, RegionLeafForce& out);
+                                     LeafContacts& leaf, RegionLeafForce& out);
 
 }  // namespace stencil::engine
