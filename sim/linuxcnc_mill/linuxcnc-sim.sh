@@ -47,6 +47,8 @@ Commands:
   estop DIR [press|release]
                  Press (default) or release the external e-stop button (HAL signal estop-ext-ok
                  0 / 1). While pressed, LinuxCNC goes to e-stop and "set estop off" cannot leave it.
+                 Prints estop-ext-ok=0|1 set_between=T0,T1: halcmd set the signal between those
+                 CLOCK_REALTIME seconds (the instance look-up before it can take a second).
   ferror DIR [JOINT [MAXV]]
                  Make the simulated motor of JOINT (0=X 1=Y 2=Z, default 0) slower: limit3.JOINT.maxv
                  = MAXV mm/s (default 0.5) so the next move of that joint ends in a following
@@ -356,12 +358,19 @@ cmd_kill() {
 
 halcmd_as_user() { as_user halcmd "$@"; }
 
+# Prints when halcmd set the pin (between its start and its return, CLOCK_REALTIME seconds): the
+# instance look-up before it takes 0.15 s on a quiet machine and over a second on a loaded one, so
+# the moment the button was pressed is this, not the command's start.
 cmd_estop() {
+    local value t0
     case "${1:-press}" in
-        press|on) halcmd_as_user sets estop-ext-ok 0 ;;
-        release|off) halcmd_as_user sets estop-ext-ok 1 ;;
+        press|on) value=0 ;;
+        release|off) value=1 ;;
         *) die "estop DIR [press|release]" ;;
     esac
+    t0=$EPOCHREALTIME
+    halcmd_as_user sets estop-ext-ok "$value" || return
+    echo "estop-ext-ok=$value set_between=$t0,$EPOCHREALTIME"
 }
 
 cmd_ferror() {
