@@ -8,6 +8,7 @@ namespace stencil::hal {
 
 // Nanoseconds on a monotonic clock with an arbitrary epoch. Never goes back.
 using MonotonicNs = std::int64_t;
+inline constexpr MonotonicNs kNsPerSecond = 1'000'000'000;
 
 class Clock {
  public:

@@ -9,7 +9,6 @@ namespace stencil::sim::cy545 {
 
 namespace {
 
-constexpr hal::MonotonicNs kNsPerSecond = 1'000'000'000;
 constexpr hal::MonotonicNs kNsPerMillisecond = 1'000'000;
 constexpr std::uint32_t kRegisterModulus = kMax24Bit + 1;
 constexpr std::uint8_t kBusyBit = static_cast<std::uint8_t>(1u << kBitBusyCts);
@@ -261,7 +260,7 @@ void Cy545Chip::start_home(std::uint32_t bit_argument, hal::MonotonicNs at_ns) {
   home_.bit_argument = bit_argument;
   home_.stepping_away = bit_matches(bit_argument);
   home_.phase_start_ns = at_ns;
-  home_.step_interval_ns = kNsPerSecond / static_cast<hal::MonotonicNs>(first_rate_);
+  home_.step_interval_ns = hal::kNsPerSecond / static_cast<hal::MonotonicNs>(first_rate_);
   home_.steps_in_phase = 0;
   activity_ = Activity::homing;
 }

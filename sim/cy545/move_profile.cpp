@@ -4,11 +4,9 @@
 #include <algorithm>
 #include <cmath>
 
-namespace stencil::sim::cy545 {
+#include "hal/clock.hpp"
 
-namespace {
-constexpr std::int64_t kNsPerSecond = 1'000'000'000;
-}
+namespace stencil::sim::cy545 {
 
 double MoveProfile::acceleration_steps_per_s2(std::uint32_t slope) {
   return 3906.0 * 25.0 / (256.0 - static_cast<double>(slope));
@@ -35,7 +33,7 @@ double MoveProfile::accelerating_seconds(double distance) const {
 
 std::int64_t MoveProfile::step_offset_ns(std::uint32_t k) const {
   if (!ramped_) {
-    return static_cast<std::int64_t>(k) * kNsPerSecond / static_cast<std::int64_t>(rate_);
+    return static_cast<std::int64_t>(k) * hal::kNsPerSecond / static_cast<std::int64_t>(rate_);
   }
   const double position = static_cast<double>(k);
   const double total = static_cast<double>(steps_);
@@ -47,7 +45,7 @@ std::int64_t MoveProfile::step_offset_ns(std::uint32_t k) const {
   } else {
     seconds = total_seconds_ - accelerating_seconds(total - position);
   }
-  return static_cast<std::int64_t>(std::llround(seconds * static_cast<double>(kNsPerSecond)));
+  return static_cast<std::int64_t>(std::llround(seconds * static_cast<double>(hal::kNsPerSecond)));
 }
 
 }  // namespace stencil::sim::cy545

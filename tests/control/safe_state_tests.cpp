@@ -63,3 +63,12 @@ TEST(SafeState, OnlyTheReasonsTheDevicesSamplesGiveAreDeviceReasons) {
   static_assert(is_device_reason(SafeReason::PoseJump) && !is_device_reason(SafeReason::Stopped),
                 "usable where a constant is needed");
 }
+
+TEST(SafeState, EveryReasonsByteIsAReasonAndTheNextOneIsNot) {
+  for (const NamedReason& r : kReasons) {
+    CHECK_TEXT(is_safe_reason_byte(static_cast<std::uint8_t>(r.reason)), r.name);
+  }
+  constexpr std::size_t count = sizeof(kReasons) / sizeof(kReasons[0]);
+  CHECK_FALSE(is_safe_reason_byte(static_cast<std::uint8_t>(count)));
+  CHECK_FALSE(is_safe_reason_byte(255));
+}

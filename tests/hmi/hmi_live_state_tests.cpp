@@ -80,6 +80,12 @@ TEST_GROUP(HmiLiveState) {
   void teardown() override { MemoryLeakWarningPlugin::restoreNewDeleteOverloads(); }
 };
 
+TEST(HmiLiveState, JsonGoesToThePageCompactWithBadUtf8ReplacedInsteadOfAThrow) {
+  // A part's file name is whatever bytes the file system holds: "\xff" is no UTF-8.
+  const nlohmann::json value = {{"part", std::string("hex\xff.stl")}, {"n", 2}};
+  STRCMP_EQUAL("{\"n\":2,\"part\":\"hex\xef\xbf\xbd.stl\"}", json_text(value).c_str());
+}
+
 TEST(HmiLiveState, WithoutAControllerTheDisplaySaysItIsWaiting) {
   LiveState state;
   state.set_link(display_link::LinkState::Waiting, "no controller at /run/x.sock: waiting for one");

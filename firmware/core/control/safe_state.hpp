@@ -27,6 +27,11 @@ enum class SafeReason : std::uint8_t {
          reason == SafeReason::PoseOutOfWorkspace || reason == SafeReason::PoseJump;
 }
 
+// Whether a byte read back (a journal's record) names a SafeReason: the last one is Stopped.
+[[nodiscard]] constexpr bool is_safe_reason_byte(std::uint8_t value) {
+  return value <= static_cast<std::uint8_t>(SafeReason::Stopped);
+}
+
 // A short fixed name, for reports and logs ("device_stale", ...).
 [[nodiscard]] const char* safe_reason_name(SafeReason reason);
 

@@ -46,10 +46,6 @@ display_link::Message message_of(const Request& request, std::uint32_t id) {
   return display_link::make_message(display_link::MessageKind::Stop, id);
 }
 
-std::string text_of(const nlohmann::json& value) {
-  return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
-}
-
 nlohmann::json reply(const char* type, const Request* request, const std::string& detail) {
   nlohmann::json out{{"type", type}};
   if (request != nullptr) {
@@ -79,7 +75,7 @@ DisplayApp::DisplayApp(DisplayAppOptions options) : options_(std::move(options))
     if (!may_control) {
       hello["reason"] = "watch-only: open the page with ?token=... (the display's --token-file) to change anything";
     }
-    return text_of(hello);
+    return json_text(hello);
   };
   handlers.part = [this] { return state_.has_feed() ? state_.part_json() : std::string(); };
   handlers.status = [this] {
@@ -89,7 +85,7 @@ DisplayApp::DisplayApp(DisplayAppOptions options) : options_(std::move(options))
     status["coverage"] = state_.coverage();
     status["touched"] = state_.touched_count();
     status["frames"] = sequence_;
-    return text_of(status);
+    return json_text(status);
   };
   web_ = std::make_unique<WebServer>(options_.web, std::move(handlers));
 }
@@ -125,7 +121,7 @@ std::string DisplayApp::handle_message(ClientId client, bool may_control, std::s
   if (!parse_request(text, request, error)) {
     const std::lock_guard<std::mutex> lock(counters_mutex_);
     ++counters_.malformed;
-    return text_of(reply("error", nullptr, error));
+    return json_text(reply("error", nullptr, error));
   }
   std::string refused;
   if (!may_control) {
@@ -156,7 +152,7 @@ std::string DisplayApp::handle_message(ClientId client, bool may_control, std::s
   }
   const std::lock_guard<std::mutex> lock(counters_mutex_);
   ++counters_.refused;
-  return text_of(reply("refused", &request, refused));
+  return json_text(reply("refused", &request, refused));
 }
 
 void DisplayApp::take_answers() {
@@ -175,12 +171,12 @@ void DisplayApp::take_answers() {
       ++(accepted ? counters_.accepted : counters_.refused);
     }
     web_->send(pending.client,
-               text_of(accepted ? reply("accepted", &pending.request, "passed to the cycle; its outcome comes in the frames' params")
+               json_text(accepted ? reply("accepted", &pending.request, "passed to the cycle; its outcome comes in the frames' params")
                                 : reply("refused", &pending.request, display_link::reason_of(answer))));
   }
   if (client_.state() != display_link::LinkState::Connected && !pending_.empty()) {
     for (const auto& [id, pending] : pending_) {
-      web_->send(pending.client, text_of(reply("refused", &pending.request, "the controller went away before answering")));
+      web_->send(pending.client, json_text(reply("refused", &pending.request, "the controller went away before answering")));
     }
     pending_.clear();
   }
@@ -199,9 +195,9 @@ void DisplayApp::tick(bool snapshot_wanted, std::string& frame, std::string& sna
   state_.update(client_.feed(), client_.feed_generation());
   ++sequence_;
   const nlohmann::json server = server_json();
-  frame = text_of(state_.frame(sequence_, server));
+  frame = json_text(state_.frame(sequence_, server));
   if (snapshot_wanted) {
-    snapshot = text_of(state_.snapshot(sequence_, server));
+    snapshot = json_text(state_.snapshot(sequence_, server));
   }
 }
 

@@ -50,11 +50,11 @@ nlohmann::json bins(const display_link::TimingHistogram& timing) {
           {"max_us", rounded(static_cast<double>(timing.max_ns) / 1000.0, 0.1)}};
 }
 
-std::string text_of(const nlohmann::json& value) {
+}  // namespace
+
+std::string json_text(const nlohmann::json& value) {
   return value.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace);
 }
-
-}  // namespace
 
 LiveState::LiveState() { link_detail_ = "no controller yet"; }
 
@@ -92,7 +92,7 @@ void LiveState::attach(const display_link::FeedView& feed) {
     }
     reachable.push_back((feed.flags(t) & tables::kTriangleReachable) != 0 ? 1 : 0);
   }
-  part_json_ = text_of({{"triangles", triangles_},
+  part_json_ = json_text({{"triangles", triangles_},
                         {"job", std::to_string(job_id_)},
                         {"vertices", std::move(vertices)},
                         {"reachable", std::move(reachable)},

@@ -15,6 +15,10 @@
 
 namespace stencil::hmi {
 
+// JSON as the page receives it: compact, any invalid UTF-8 (a name from a file) replaced, never a
+// throw.
+[[nodiscard]] std::string json_text(const nlohmann::json& value);
+
 class LiveState {
  public:
   LiveState();

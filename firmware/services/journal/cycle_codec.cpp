@@ -54,7 +54,6 @@ std::int64_t wrapping_difference(std::int64_t a, std::int64_t b) {
 
 constexpr std::uint8_t bit_if(bool set, std::uint8_t bit) { return set ? bit : std::uint8_t{0}; }
 
-bool valid_reason(std::uint8_t value) { return value <= static_cast<std::uint8_t>(control::SafeReason::Stopped); }
 bool valid_read(std::uint8_t status, std::uint8_t reason) {
   return status <= static_cast<std::uint8_t>(hal::ReadStatus::Fault) &&
          reason <= static_cast<std::uint8_t>(hal::HapticFault::HostWatchdogTripped);
@@ -231,7 +230,7 @@ bool CycleDecoder::decode_key(ByteReader& in, std::uint8_t flags, RecordedCycle&
     error = "a key cycle cut short";
     return false;
   }
-  if (!valid_reason(reason) || !valid_read(status, read_reason)) {
+  if (!control::is_safe_reason_byte(reason) || !valid_read(status, read_reason)) {
     error = "a key cycle's safe reason " + std::to_string(reason) + ", read status " + std::to_string(status) +
             " or read reason " + std::to_string(read_reason) + " is out of range";
     return false;
@@ -328,7 +327,7 @@ bool CycleDecoder::decode(ByteReader& in, RecordedCycle& out, std::string& error
     error = "a cycle cut short (or a number in it longer than 10 bytes)";
     return false;
   }
-  if (!valid_reason(reason) || !valid_read(status, read_reason)) {
+  if (!control::is_safe_reason_byte(reason) || !valid_read(status, read_reason)) {
     error = "a cycle's safe reason " + std::to_string(reason) + ", read status " + std::to_string(status) +
             " or read reason " + std::to_string(read_reason) + " is out of range";
     return false;

@@ -18,8 +18,6 @@
 namespace stencil::journal {
 namespace {
 
-bool valid_reason(std::uint8_t value) { return value <= static_cast<std::uint8_t>(control::SafeReason::Stopped); }
-
 std::string at(std::size_t offset) { return "journal offset " + std::to_string(offset) + ": "; }
 
 }  // namespace
@@ -126,7 +124,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
           v = body.f64();
         }
         const std::uint8_t reason = body.u8();
-        if (fresh > 1 || !valid_reason(reason)) {
+        if (fresh > 1 || !control::is_safe_reason_byte(reason)) {
           result.error = at(offset) + (fresh > 1 ? "a cycle record's fresh flag is " + std::to_string(fresh) + " (expected 0 or 1)"
                                                  : "a cycle record's safe reason is " + std::to_string(reason) + " (no such reason)");
           return result;
@@ -190,7 +188,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         const std::uint64_t cycle = body.u64();
         const std::uint8_t reason = body.u8();
-        if (!valid_reason(reason) || reason == 0) {
+        if (!control::is_safe_reason_byte(reason) || reason == 0) {
           result.error = at(offset) + "a safe-state record's reason is " + std::to_string(reason) + " (no such reason)";
           return result;
         }
@@ -328,7 +326,7 @@ JournalReadResult read_journal(const std::uint8_t* data, std::size_t size, const
         }
         const std::uint64_t cycles = body.u64();
         const std::uint8_t reason = body.u8();
-        if (!valid_reason(reason)) {
+        if (!control::is_safe_reason_byte(reason)) {
           result.error = at(offset) + "an end record's reason is " + std::to_string(reason) + " (no such reason)";
           return result;
         }
