@@ -368,9 +368,10 @@ cmd_estop() {
         release|off) value=1 ;;
         *) die "estop DIR [press|release]" ;;
     esac
-    t0=$EPOCHREALTIME
+    # $EPOCHREALTIME has the locale's decimal separator: a point whatever the locale.
+    t0=${EPOCHREALTIME/[!0-9]/.}
     halcmd_as_user sets estop-ext-ok "$value" || return
-    echo "estop-ext-ok=$value set_between=$t0,$EPOCHREALTIME"
+    echo "estop-ext-ok=$value set_between=$t0,${EPOCHREALTIME/[!0-9]/.}"
 }
 
 cmd_ferror() {
