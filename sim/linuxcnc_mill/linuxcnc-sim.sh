@@ -55,7 +55,9 @@ Commands:
                  error. "ferror DIR reset" puts every motor back to 6 mm/s.
   kill DIR       Kill every process of the instance with SIGKILL at once, as a crash would (the
                  socket closes; lock file and shared memory stay until "stop DIR"). halsampler is
-                 let drain the samples that were taken, then stopped.
+                 let drain the samples that were taken, then stopped. Prints killed=PIDS
+                 kill_between=T0,T1: the SIGKILL was sent between those CLOCK_REALTIME seconds
+                 (the instance look-up before it can take a second).
   hal DIR ARGS   Run "halcmd ARGS" against the instance (as its user), e.g. hal DIR getp limit3.0.out
 
 Options (or the environment variables):
@@ -339,21 +341,25 @@ cmd_stop() {
     echo "stop_seconds=$(elapsed "$t0")"
 }
 
+# Prints when the SIGKILL was sent, as cmd_estop says when the pin was set, and for its reason.
 cmd_kill() {
-    local pids keep="" p
+    local pids keep="" p t0 t1
     pids="$(instance_pids)"
     [ -n "$pids" ] || { echo "$PROG: nothing runs in $DIR" >&2; return 0; }
     local victims=""
     for p in $pids; do
         if [ "$(cat /proc/$p/comm 2>/dev/null)" = halsampler ]; then keep="$keep $p"; else victims="$victims $p"; fi
     done
+    # $EPOCHREALTIME has the locale's decimal separator: a point whatever the locale.
+    t0=${EPOCHREALTIME/[!0-9]/.}
     [ -n "$victims" ] && kill -KILL $victims 2>/dev/null
+    t1=${EPOCHREALTIME/[!0-9]/.}
     # let halsampler drain the FIFO (the servo thread died with rtapi_app), then stop it
     sleep 0.5
     [ -n "$keep" ] && kill -TERM $keep 2>/dev/null
     sleep 0.2
     kill_instance
-    echo "killed=$(echo $victims $keep)"
+    echo "killed=$(echo $victims $keep) kill_between=$t0,$t1"
 }
 
 halcmd_as_user() { as_user halcmd "$@"; }

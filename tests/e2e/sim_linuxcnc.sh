@@ -68,11 +68,11 @@ run_sim() {
 # A fault in the middle of a cut: a safe state for the machine's reason, in LinuxCNC's words, the
 # force zero in that very cycle (the journal's last cycle: the run ends on it), within a machine
 # update of the fault, no gouge. fault.ns is CLOCK_MONOTONIC as the command that makes the fault
-# starts. Where the case writes fault_set.ns (the e-stop: the launcher says between which moments
-# halcmd set the pin), the bound counts from halcmd's start, so its own run (26 to 61 ms measured)
-# is inside the figure but the launcher's look-up of the instance before it is not: 0.15 s on a
-# quiet machine, over a second on a loaded CI machine, where the case failed when the bound counted
-# from the command's start. Without it (kill: no halcmd), from the command's start.
+# starts. fault_set.ns holds when the launcher says it made the fault (the e-stop: between halcmd's
+# start and return; the kill: around the SIGKILL), and the bound counts from its start, so halcmd's
+# own run (22 to 61 ms measured) is inside the figure but the launcher's look-up of the instance
+# before it is not: 0.15 s on a quiet machine, over a second on a loaded CI machine, where both
+# cases failed (437 and 406 ms) when the bound counted from the command's start.
 fault_ends_safe() {
   local what=$1 words=$2 journal_tool last fault_ns ref_ns ref_what safe_ns set_to
   journal_tool="$(dirname "$sim")/stencil-journal"
@@ -89,10 +89,12 @@ fault_ends_safe() {
     ref_what="the command that made the fault started"
     if [ -s fault_set.ns ]; then
       read -r ref_ns set_to < fault_set.ns
-      ref_what="halcmd started to set the pin ($(( (ref_ns - fault_ns) / 1000000 )) ms after the command started; halcmd ran $(( (set_to - ref_ns) / 1000000 )) ms)"
-      # Not before the pin was set: a safe state for another reason would also end the run.
+      ref_what="the launcher started to make the fault ($(( (ref_ns - fault_ns) / 1000000 )) ms after the command started; it took $(( (set_to - ref_ns) / 1000000 )) ms)"
+      # Not before the fault was made: a safe state for another reason would also end the run.
       [ "$safe_ns" -ge "$ref_ns" ] ||
-        fail "$what: the safe state came $(( (ref_ns - safe_ns) / 1000000 )) ms before halcmd started to set the pin"
+        fail "$what: the safe state came $(( (ref_ns - safe_ns) / 1000000 )) ms before the launcher started to make the fault"
+    else
+      fail "$what: the launcher did not say when it made the fault"
     fi
     echo "$what: the safe state $(( (safe_ns - fault_ns) / 1000000 )) ms after the command that made the fault started," \
          "$(( (safe_ns - ref_ns) / 1000000 )) ms after $ref_what"
@@ -104,12 +106,13 @@ fault_ends_safe() {
 
 # now_ns: CLOCK_MONOTONIC, as the journal's times.
 now_ns() { python3 -c 'import time; print(time.monotonic_ns())'; }
-# monotonic_of_set FILE: the launcher's "set_between=T0,T1" (CLOCK_REALTIME seconds) as two
-# CLOCK_MONOTONIC ns, through the two clocks' offset read now (seconds later: no step between).
+# monotonic_of_set FILE: the launcher's "set_between=T0,T1" or "kill_between=T0,T1" (CLOCK_REALTIME
+# seconds) as two CLOCK_MONOTONIC ns, through the two clocks' offset read now (seconds later: no
+# step between).
 monotonic_of_set() {
   python3 - "$1" <<'PY'
 import re, sys, time
-m = re.search(r"set_between=([0-9.]+),([0-9.]+)", open(sys.argv[1]).read())
+m = re.search(r"(?:set|kill)_between=([0-9.]+),([0-9.]+)", open(sys.argv[1]).read())
 if m:
     offset = time.monotonic_ns() - time.time_ns()
     print(*(int(round(float(t) * 1e9)) + offset for t in m.groups()))
@@ -179,9 +182,10 @@ case_estop_mid_cut_is_a_safe_state() {
 case_killed_mid_cut_is_a_safe_state() {
   start_mill
   rig_config
-  (sleep 12; now_ns > fault.ns; bash "$launcher" kill "$mill" > kill.txt 2>&1) &
+  (sleep 12; now_ns > fault.ns; bash "$launcher" kill "$mill" > kill.txt 2>&1; monotonic_of_set kill.txt > fault_set.ns) &
   run_sim --duration 30
   wait
+  [ -s fault_set.ns ] || fail "LinuxCNC killed: the launcher did not say when it sent the SIGKILL: $(cat kill.txt)"
   fault_ends_safe "LinuxCNC killed" "the connection to linuxcncrsh"
 }
 
