@@ -22,6 +22,7 @@ struct Tally {
   int settled = 0;
   int region_or_outside = 0;
   int split = 0;
+  int wholly_penetrating = 0;  // sampled points of boxes whose shallowest depth is beyond the tolerance
 };
 
 // Checks the box's answer against classify_meridian at its corners and at random points in it.
@@ -53,6 +54,16 @@ void check_box(const ToolBsp& tool, const MeridianBox& box, std::mt19937_64& ran
         const ImplicitSurface& surface = tool.surfaces[tool.regions[part.region].surface];
         const double depth = interior_distance(surface, point);
         CHECK(depth <= part.deepest_bound_mm);
+        // The range's shallow end: a box wholly beyond the tolerance has every point penetrating
+        // (the query settles such a leaf without visiting its points).
+        const DepthRange range = region_depth_range(tool, part.region, box);
+        DOUBLES_EQUAL(region_deepest_bound(tool, part.region, box), range.deepest_mm, 0.0);
+        CHECK(range.shallowest_mm <= depth);
+        if (range.shallowest_mm > kSurfaceTolerance_mm) {
+          ++tally.wholly_penetrating;
+          CHECK(truth.contact == PointContact::Penetrating);
+          LONGS_EQUAL(part.region, truth.region);
+        }
         if (part.cover == BoxCover::Region) {
           CHECK(truth.contact != PointContact::Outside);
         }
@@ -109,6 +120,7 @@ TEST(MeridianBox, EverySettledBoxAgreesWithEachOfItsPointsAndSmallBoxesAreMostly
     // Boxes of a leaf's size (well under the tool's features) rarely straddle two tests at once.
     CHECK_TEXT(small.settled > 19 * small.boxes / 20, sample.name);
     CHECK_TEXT(small.region_or_outside > 0, sample.name);
+    CHECK_TEXT(small.wholly_penetrating > 0, sample.name);  // the check above is not vacuous
   }
 }
 

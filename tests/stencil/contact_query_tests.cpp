@@ -1,8 +1,10 @@
 // The contact query on the default part: force along the face normal with magnitude k*d, none in
 // free space, legality, and touched triangles marked at the tool's pose.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -154,8 +156,12 @@ TEST(ContactForceContinuity, ForceChangesSmoothlyAsContactCrossesTheToolsRegions
 TEST_GROUP(ContactQueryOracle){};
 
 // The query settles whole leaves at once (the leaf's box against the tool tree, the points' numbers
-// lane by lane); here every point goes through classify_at_pose on its own, in a plain loop, and
-// the results must agree: count, deepest point, force and torque, legality, touched triangles.
+// lane by lane, and a leaf wholly deeper than the tolerance from its moments alone); here every
+// point goes through classify_at_pose on its own, in a plain loop, and the results must agree:
+// count, deepest point and depth exactly, legality, touched triangles; force and torque to the
+// float lanes' rounding where no leaf lies wholly in the part (no leaf can be settled from its
+// moments), and otherwise to what the moments leave out: the force's direction within half a
+// degree, its torque per newton within 0.05 mm.
 TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
   std::mt19937_64 random(404);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
@@ -173,6 +179,10 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
     geometry::ToolBsp contact_tool{};
     CHECK(build_contact_tool(part.tool.spec, kTolerance, contact_tool));
     int poses_in_contact = 0;
+    int poses_exact = 0;
+    int poses_from_moments = 0;
+    double worst_angle = 0.0;
+    double worst_lever = 0.0;
     for (int trial = 0; trial < 300; ++trial) {
       // Tips near the top face, the side faces and the prism's edges, up to 0.6 mm into the part,
       // and low beside the side faces so that the tool's partition planes (a ball's equator, a
@@ -191,6 +201,7 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       const Eigen::Vector3d centre = tip + parameters.compliance_centre_mm * Eigen::Vector3d::UnitZ();
       TriangleSet expected_touched;
       const Eigen::Vector3d inflated_tip = tip - kTolerance * Eigen::Vector3d::UnitZ();
+      std::vector<bool> penetrates(part.point_count(), false);
       for (std::uint32_t i = 0; i < part.point_count(); ++i) {
         const Eigen::Vector3d p(part.points[i].x_mm, part.points[i].y_mm, part.points[i].z_mm);
         const tables::PackedPoint normal = tables::point_normal(part, i);
@@ -203,6 +214,7 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
         if (c.contact != geometry::PointContact::Penetrating) {
           continue;
         }
+        penetrates[i] = true;
         ++count;
         deepest = std::max(deepest, c.depth_mm);
         const Eigen::Vector3d direction = n - c.escape_direction;
@@ -224,11 +236,32 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       LONGS_EQUAL(count, result.penetrating_points);
       DOUBLES_EQUAL(deepest, result.max_depth_mm, 1e-12);
       const double scale = force.norm() > 0.0 ? k_world * deepest / force.norm() : 0.0;
-      // The lanes compute each point's force and torque in single precision (24-bit), so the sums
-      // agree to the terms' rounding bound above (torques about the compliance centre 10 mm up
-      // cancel to far less than their terms, so the bound is on the terms, not on the sum).
-      CHECK((result.force_n - scale * force).norm() <= 1e-9 + scale * force_terms);
-      CHECK((result.torque_nmm - scale * torque).norm() <= 1e-9 + scale * torque_terms);
+      bool a_leaf_wholly_in = false;
+      for (std::uint32_t leaf = 0; leaf < part.leaf_count(); ++leaf) {
+        const tables::LeafBlock& block = part.leaves[leaf];
+        bool all = true;
+        for (std::uint32_t i = block.first_point; i < block.first_point + block.point_count; ++i) {
+          all = all && penetrates[i];
+        }
+        a_leaf_wholly_in = a_leaf_wholly_in || all;
+      }
+      if (!a_leaf_wholly_in) {
+        // The lanes compute each point's force and torque in single precision (24-bit), so the sums
+        // agree to the terms' rounding bound above (torques about the compliance centre 10 mm up
+        // cancel to far less than their terms, so the bound is on the terms, not on the sum).
+        CHECK((result.force_n - scale * force).norm() <= 1e-9 + scale * force_terms);
+        CHECK((result.torque_nmm - scale * torque).norm() <= 1e-9 + scale * torque_terms);
+        ++poses_exact;
+      } else if (count > 0) {
+        // The same magnitude (k times the deepest depth), its direction and the torque per newton
+        // as near as the leaves' moments give them.
+        DOUBLES_EQUAL(k_world * deepest, result.force_n.norm(), 1e-9);
+        const double turned = std::acos(std::min(1.0, result.force_n.normalized().dot(force.normalized())));
+        const double lever = (result.torque_nmm - scale * torque).norm() / (k_world * deepest);
+        worst_angle = std::max(worst_angle, turned);
+        worst_lever = std::max(worst_lever, lever);
+        ++poses_from_moments;
+      }
       if (count > 0) {
         const ContactResult again = query_contacts(part, pose, parameters);  // the same bits
         CHECK(again.max_depth_mm == result.max_depth_mm && again.deepest_point == result.deepest_point &&
@@ -248,5 +281,10 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       }
     }
     CHECK_TEXT(poses_in_contact > 60, tool_text);
+    // Measured with this seed: at most 0.095 degrees and 0.015 mm (the flat end), 0 for poses
+    // where no leaf could be settled whole.
+    CHECK_TEXT(poses_exact > 50 && poses_from_moments > 50, tool_text);
+    CHECK_TEXT(worst_angle < 0.5 / 57.29577951308232, tool_text);
+    CHECK_TEXT(worst_lever < 0.05, tool_text);
   }
 }

@@ -20,6 +20,7 @@
 #include "firmware/core/geometry/tool_bsp.hpp"
 #include "firmware/core/geometry/tool_bsp_builder.hpp"
 #include "firmware/core/stencil/leaf_contacts.hpp"
+#include "firmware/core/tables/leaf_moments.hpp"
 
 // CppUTest last: its leak-detector macros redefine new for what follows.
 #include <CppUTest/TestHarness.h>
@@ -433,4 +434,128 @@ TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {
   load_leaf(points.part, points.packed(), kTip, leaf);
   RegionLeafForce out{};
   CHECK_FALSE(region_leaf_force(damaged, cover.region, false, true, 10.0, 7.5, leaf, out));
+}
+
+namespace {
+
+// A patch of `n` points around `centre` (offsets from kTip) on the plane through it with normal
+// `normal` (each point's normal `normal`, or `other` for every second point), spread over a disc of
+// radius `radius`, packed with its sphere and moments as the table generator packs them.
+struct MomentLeaf {
+  std::array<tables::PackedPoint, tables::kMaxLeafPoints> points{};
+  tables::LeafBlock block{};
+
+  MomentLeaf(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius, const Eigen::Vector3d& other) {
+    const Eigen::Vector3d u = normal.unitOrthogonal();
+    const Eigen::Vector3d v = normal.cross(u);
+    block.point_count = tables::kMaxLeafPoints;
+    for (std::uint32_t i = 0; i < tables::kMaxLeafPoints; ++i) {
+      const double t = static_cast<double>(i);
+      const double s = radius * std::sqrt((t + 0.5) / tables::kMaxLeafPoints);  // a sunflower: even cover
+      const Eigen::Vector3d p = kTip + centre + s * (std::cos(2.39996 * t) * u + std::sin(2.39996 * t) * v);
+      points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+      const Eigen::Vector3d n = i % 2 == 0 ? normal : other;
+      block.x_mm[i] = points[i].x_mm;
+      block.y_mm[i] = points[i].y_mm;
+      block.z_mm[i] = points[i].z_mm;
+      block.nx[i] = static_cast<float>(n.x());
+      block.ny[i] = static_cast<float>(n.y());
+      block.nz[i] = static_cast<float>(n.z());
+    }
+    const Eigen::Vector3d middle = kTip + centre;
+    double farthest = 0.0;
+    for (std::uint32_t i = 0; i < tables::kMaxLeafPoints; ++i) {
+      farthest = std::max(farthest, (point(i) - middle.cast<float>().cast<double>()).norm());
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+      block.centre_mm[axis] = static_cast<float>(middle[axis]);
+    }
+    block.radius_mm = static_cast<float>(farthest * (1.0 + 1e-6));
+    const tables::LeafMoments moments = tables::leaf_moments(block);
+    std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
+    std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
+  }
+
+  [[nodiscard]] Eigen::Vector3d point(std::uint32_t i) const {
+    return {double{points[i].x_mm}, double{points[i].y_mm}, double{points[i].z_mm}};
+  }
+  [[nodiscard]] Eigen::Vector3d normal(std::uint32_t i) const {
+    return {double{block.nx[i]}, double{block.ny[i]}, double{block.nz[i]}};
+  }
+};
+
+// The leaf's points through the tool tree one by one: the force and torque the lanes would sum,
+// and the region every point is in (each must penetrate, in one region).
+struct PointSums {
+  LeafForceSums sums{Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  std::uint8_t region = 0;
+};
+PointSums sums_point_by_point(const geometry::ToolBsp& tool, const MomentLeaf& leaf, double k, const Eigen::Vector3d& centre) {
+  PointSums out;
+  for (std::uint32_t i = 0; i < tables::kMaxLeafPoints; ++i) {
+    const auto c = geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), leaf.point(i));
+    CHECK(c.contact == geometry::PointContact::Penetrating);
+    CHECK(i == 0 || c.region == out.region);
+    out.region = c.region;
+    const Eigen::Vector3d f = k * c.depth_mm * (leaf.normal(i) - c.escape_direction).normalized();
+    out.sums.force += f;
+    out.sums.torque += (leaf.point(i) - centre).cross(f);
+  }
+  return out;
+}
+
+constexpr geometry::ToolSpec kFlat{geometry::CutterKind::Flat, 3.0, 12.0, 0.0, 10.0, 20.0};
+
+}  // namespace
+
+// Under a flat end's bottom, on a slanted face: the depth changes linearly over the leaf and the
+// escape direction not at all, so the moments give the points' own force sum, to rounding; the
+// torque puts that force at the centroid, where the deeper points pull it towards their side: its
+// line of action stays within the leaf.
+TEST(LeafContacts, ALeafUnderAFlatBottomHasFromItsMomentsTheForceOfItsPoints) {
+  geometry::ToolBsp flat{};
+  CHECK(geometry::build_tool_bsp(kFlat, flat).ok);
+  const Eigen::Vector3d normal = Eigen::Vector3d(0.2, -0.1, 1.0).normalized();
+  const MomentLeaf patch(Eigen::Vector3d(0.3, -0.2, 0.4), normal, 0.5, normal);
+  const double k = 10.0;
+  const Eigen::Vector3d centre = kTip + Eigen::Vector3d(0.0, 0.0, 10.0);
+  const PointSums exact = sums_point_by_point(flat, patch, k, centre);
+  const LeafMomentForce moment =
+      leaf_moment_force(flat.surfaces[flat.regions[exact.region].surface], patch.block, kTip, centre, k);
+  CHECK(moment.settled);
+  CHECK(exact.sums.force.norm() > 100.0);
+  CHECK((moment.force - exact.sums.force).norm() < 1e-5 * exact.sums.force.norm());
+  const double lever_error = (moment.torque - exact.sums.torque).norm() / exact.sums.force.norm();
+  CHECK(lever_error < double{patch.block.radius_mm});
+  CHECK(lever_error > 1e-4);  // the depth's slope over the leaf moves it: not the sum itself
+}
+
+// A leaf across an edge (half its normals one way, half another) is not settled from its moments.
+TEST(LeafContacts, ALeafAcrossAnEdgeIsVisitedPointByPointNotSettledFromItsMoments) {
+  geometry::ToolBsp flat{};
+  CHECK(geometry::build_tool_bsp(kFlat, flat).ok);
+  const MomentLeaf patch(Eigen::Vector3d(0.3, -0.2, 0.4), Eigen::Vector3d::UnitZ(), 0.2, Eigen::Vector3d::UnitX());
+  const PointSums exact = sums_point_by_point(flat, patch, 10.0, kTip);
+  CHECK_FALSE(leaf_moment_force(flat.surfaces[flat.regions[exact.region].surface], patch.block, kTip, kTip, 10.0).settled);
+}
+
+// In the ball, whose escape directions turn about its centre: a leaf small against its distance to
+// the centre and its depth is settled near its points' sum (the error estimate bounds it); one as
+// wide as the ball's radius is not.
+TEST(LeafContacts, ALeafSmallAgainstTheBallsCurvatureIsSettledNearItsSumAndAWideOneIsNot) {
+  const double k = 10.0;
+  const Eigen::Vector3d centre = kTip + Eigen::Vector3d(0.0, 0.0, 10.0);
+  const Eigen::Vector3d where(0.4, 0.3, 1.0);  // 0.5 mm from the ball's centre (1.5 up), 1 mm deep
+  const Eigen::Vector3d normal = Eigen::Vector3d(-0.3, 0.5, 1.0).normalized();
+  const MomentLeaf small(where, normal, 0.08, normal);
+  const PointSums exact = sums_point_by_point(tool, small, k, centre);
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[exact.region].surface];
+  CHECK(surface.kind == geometry::SurfaceKind::Sphere);
+  const LeafMomentForce moment = leaf_moment_force(surface, small.block, kTip, centre, k);
+  CHECK(moment.settled);
+  CHECK((moment.force - exact.sums.force).norm() < kMomentError * exact.sums.force.norm());
+  CHECK((moment.force - exact.sums.force).norm() > 1e-7 * exact.sums.force.norm());  // not the sum itself
+  const MomentLeaf wide(where, normal, 0.4, normal);
+  static_cast<void>(sums_point_by_point(tool, wide, k, centre));  // still wholly inside, in the ball
+  CHECK_FALSE(leaf_moment_force(surface, wide.block, kTip, centre, k).settled);
 }

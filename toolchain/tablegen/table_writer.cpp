@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 
+#include "firmware/core/tables/leaf_moments.hpp"
 #include "firmware/core/tables/table_loader.hpp"
 #include "firmware/core/tables/tool_section.hpp"
 #include "toolchain/tablegen/file_io.hpp"
@@ -76,6 +77,9 @@ std::vector<tables::LeafBlock> pack_leaves(TableContents& contents) {
       radius = std::max(radius, (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).norm());
     }
     block.radius_mm = std::nextafter(float_at_least(radius), std::numeric_limits<float>::infinity());
+    const tables::LeafMoments moments = tables::leaf_moments(block);
+    std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
+    std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
     leaves.push_back(block);
   }
   return leaves;

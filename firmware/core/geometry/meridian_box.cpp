@@ -195,6 +195,11 @@ double region_deepest_bound(const ToolBsp& tool, std::uint8_t region, const Meri
   return interior_range(tool.surfaces[tool.regions[region].surface], box).high;
 }
 
+DepthRange region_depth_range(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box) {
+  const Range range = interior_range(tool.surfaces[tool.regions[region].surface], box);
+  return {range.low, range.high};
+}
+
 MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
                                  const Eigen::Vector3d& high) {
   // Subtraction, squaring, addition and sqrt are each monotonic, so the nearest and farthest

@@ -57,6 +57,17 @@ struct BoxClassification {
 // the same arithmetic. NaN when the surface's numbers are.
 [[nodiscard]] double region_deepest_bound(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box);
 
+// Every point of `box` is between these depths inside the surface of region `region`, as
+// classify_meridian rounds it: region_deepest_bound's number and the shallowest counterpart, by the
+// same arithmetic. A box settled in that region (Region or RegionOrOutside) whose shallowest depth
+// is beyond kSurfaceTolerance_mm has every point in the region and penetrating. NaN when the
+// surface's numbers are.
+struct DepthRange {
+  double shallowest_mm;
+  double deepest_mm;
+};
+[[nodiscard]] DepthRange region_depth_range(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box);
+
 // The meridian box that holds every point of the axis-aligned world box [low, high] as seen from
 // an upright tool (axis +z) with its tip at tip_mm, computed as the query computes each point's
 // r and z (local = point - tip, r = sqrt(x^2 + y^2)).

@@ -1,8 +1,10 @@
 // The query: the tool's 14-DOP against the points' tree, then each nearby point through the tool BSP.
 #include "firmware/core/stencil/contact_query.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Geometry>
 
@@ -70,7 +72,12 @@ enum class Wanted : std::uint8_t {
 };
 
 // What a visitor of a leaf tells the walk.
-enum class LeafVisit : std::uint8_t { Continue, Stop, Fault };
+enum class LeafVisit : std::uint8_t {
+  Continue,
+  Stop,
+  Fault,
+  Visit,  // (visit_deep_leaf) the block's own numbers do not settle it: visit its points after all
+};
 
 // A leaf wholly in one region (or in it or outside), its lanes settled, given to visit_leaf: the
 // visit of a settled leaf for walkers that want every lane's verdict.
@@ -104,10 +111,40 @@ bool shallower_than_penetration(double deepest_bound_mm) {
   return deepest_bound_mm < 0.5 * geometry::kSurfaceTolerance_mm;
 }
 
-template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf>
+// The leaf blocks of the subtree under node `index`: its leftmost leaf's to its rightmost leaf's.
+// The loader holds the nodes in the walk's order and the leaves numbered in it, so every leaf of
+// the subtree, and no other, is in that run. False for a tree the loader would have refused.
+struct LeafRun {
+  std::uint32_t first;
+  std::uint32_t last;
+};
+bool leaves_below(const tables::PartTables& part, std::uint32_t index, LeafRun& run) {
+  std::uint32_t leftmost = index;
+  std::uint32_t rightmost = index;
+  for (std::uint32_t step = 0; step <= tables::kMaxTreeDepth; ++step) {
+    if (leftmost >= part.node_count() || rightmost >= part.node_count()) {
+      return false;
+    }
+    const tables::BvhNode& left = part.nodes[leftmost];
+    const tables::BvhNode& right = part.nodes[rightmost];
+    if (left.point_count > 0 && right.point_count > 0) {
+      run = {left.leaf, right.leaf};
+      return run.first <= run.last && run.last < part.leaf_count();
+    }
+    leftmost = left.point_count > 0 ? leftmost : leftmost + 1;
+    rightmost = right.point_count > 0 ? rightmost : right.right_child;
+  }
+  return false;
+}
+
+// A leaf settled in one region whose shallowest point (by its box) is deeper than the tolerance
+// has every point penetrating, all in that region: when only penetrating points are wanted, the
+// walk gives it to visit_deep_leaf(cover, block) unloaded, which settles it from the block's own
+// numbers (its count, sphere and moments) without visiting its points.
+template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf, typename VisitDeepLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
                          Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf,
-                         VisitRegionLeaf&& visit_region_leaf) {
+                         VisitRegionLeaf&& visit_region_leaf, VisitDeepLeaf&& visit_deep_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
   std::array<Pending, tables::kMaxTreeDepth + 1> stack;
@@ -128,13 +165,15 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
     const bool settled = pending.settled != geometry::BoxCover::Mixed;
     geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
+    double shallowest_mm = -1.0;  // of a box settled in one region: no point is shallower (known when settled)
     if (settled) {
-      const double bound =
-          geometry::region_deepest_bound(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
-      if (shallower_than_penetration(bound)) {
+      const geometry::DepthRange range =
+          geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
+      if (shallower_than_penetration(range.deepest_mm)) {
         continue;
       }
-      cover = {pending.settled, pending.region, bound, 0.0, {}, {}};
+      cover = {pending.settled, pending.region, range.deepest_mm, 0.0, {}, {}};
+      shallowest_mm = range.shallowest_mm;
     } else if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
     }
@@ -148,11 +187,28 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       const tables::LeafBlock& block = part.leaves[node.leaf];
       if (upright) {
         if (!settled) {
-          cover = geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+          const geometry::MeridianBox box = geometry::upright_meridian_box(pose.tip_mm, low, high);
+          cover = geometry::classify_meridian_box(tool, box);
           if (cover.cover == geometry::BoxCover::Outside ||
               (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
                shallower_than_penetration(cover.deepest_bound_mm))) {
             continue;
+          }
+          if (wanted == Wanted::Penetrating &&
+              (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside)) {
+            shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
+          }
+        }
+        if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {
+          switch (visit_deep_leaf(cover, block)) {  // NaN bounds never get here
+            case LeafVisit::Continue:
+              continue;
+            case LeafVisit::Stop:
+              return Walk::Stopped;
+            case LeafVisit::Fault:
+              return Walk::BadTree;
+            case LeafVisit::Visit:
+              break;
           }
         }
         load_leaf(part, block, pose.tip_mm, leaf);
@@ -163,6 +219,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             case LeafVisit::Stop:
               return Walk::Stopped;
             case LeafVisit::Fault:
+            case LeafVisit::Visit:
               break;
           }
           return Walk::BadTree;
@@ -192,14 +249,48 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     Pending child{0, pending.settled, pending.region};
     if (upright && wanted == Wanted::Penetrating && !settled) {
-      cover = geometry::classify_meridian_box(tool, geometry::upright_meridian_box(pose.tip_mm, low, high));
+      const geometry::MeridianBox box = geometry::upright_meridian_box(pose.tip_mm, low, high);
+      cover = geometry::classify_meridian_box(tool, box);
       if (cover.cover == geometry::BoxCover::Outside ||
           (cover.cover != geometry::BoxCover::Mixed && shallower_than_penetration(cover.deepest_bound_mm))) {
         continue;  // as each of its leaves would be
       }
       if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
         child = {0, cover.cover, cover.region};
+        shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
       }
+    }
+    if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {
+      // Every point below is deep: each leaf of the subtree (a run of leaf blocks, numbered in the
+      // walk's order) goes to visit_deep_leaf in that order, with no box below this one looked at.
+      LeafRun run{};
+      if (!leaves_below(part, index, run)) {
+        return Walk::BadTree;
+      }
+      for (std::uint32_t leaf_index = run.first; leaf_index <= run.last; ++leaf_index) {
+        const tables::LeafBlock& block = part.leaves[leaf_index];
+        if (block.point_count == 0 || block.point_count > tables::kMaxLeafPoints ||
+            block.first_point > part.point_count() || block.point_count > part.point_count() - block.first_point) {
+          return Walk::BadTree;  // a block the loader would have refused
+        }
+        LeafVisit visit = visit_deep_leaf(cover, block);
+        if (visit == LeafVisit::Visit) {
+          // Its points after all, with the subtree's bound (its own box is not looked at).
+          load_leaf(part, block, pose.tip_mm, leaf);
+          visit = visit_region_leaf(cover, leaf);
+        }
+        switch (visit) {
+          case LeafVisit::Continue:
+            continue;
+          case LeafVisit::Stop:
+            return Walk::Stopped;
+          case LeafVisit::Fault:
+          case LeafVisit::Visit:
+            break;
+        }
+        return Walk::BadTree;
+      }
+      continue;
     }
     if (size + 2 > stack.size()) {
       return Walk::BadTree;  // deeper than the loader allows: the tables were not loaded by it
@@ -210,6 +301,29 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     stack[size++] = child;
   }
   return Walk::Finished;
+}
+
+// The pending search for the deepest point of leaves settled whole (visit_deep_leaf): the query
+// counts and pushes such a leaf at once, but looks for its deepest point only after the walk, and
+// only while the leaf's bound can still beat the deepest point found, best bound first; a leaf the
+// list has no room for is searched at once. 256 is past the deepest contact the bench measures
+// (206 such leaves at 1e6 points in the deep corner).
+inline constexpr std::size_t kMaxPendingDeepLeaves = 256;
+struct PendingDeepLeaf {
+  std::uint32_t leaf;
+  std::uint8_t region;
+  double deepest_bound_mm;
+};
+
+// The deepest any point of the leaf can be inside `surface`: its sphere's centre's depth plus its
+// radius (the depth is a distance, so it changes no faster than the point moves), with a margin
+// for the rounding of that one depth.
+double sphere_deepest_bound(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
+                            const Eigen::Vector3d& tip_mm) {
+  const Eigen::Vector3d offset =
+      Eigen::Vector3d(block.centre_mm[0], block.centre_mm[1], block.centre_mm[2]) - tip_mm;
+  const geometry::MeridianPoint meridian{std::sqrt(offset.x() * offset.x() + offset.y() * offset.y()), offset.z()};
+  return geometry::interior_distance(surface, meridian) + double{block.radius_mm} + 1e-9;
 }
 
 // The normal of `point`, of the leaf whose block is `block`.
@@ -230,6 +344,26 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   const Eigen::Vector3d centre = pose.tip_mm + parameters.compliance_centre_mm * pose.axis;
   Eigen::Vector3d force_sum = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque_sum = Eigen::Vector3d::Zero();
+  // Whether a point (or a leaf of points from `first` on) this deep may be the deepest: deeper, or
+  // as deep and earlier in the walk's order (the points' order), as the walk alone would pick it.
+  const auto may_beat = [&](double depth, std::uint32_t first) {
+    return depth > result.max_depth_mm ||
+           (depth == result.max_depth_mm && result.max_depth_mm > 0.0 && first < result.deepest_point);
+  };
+  LeafContacts searched;
+  const auto search_deepest = [&](std::uint32_t leaf_index, std::uint8_t region) {
+    load_leaf(part, part.leaves[leaf_index], pose.tip_mm, searched);
+    if (!region_leaf_contacts(part.tool, region, false, searched)) {
+      return false;
+    }
+    if (searched.penetrating > 0 && may_beat(searched.max_depth_mm, searched.first + searched.deepest_lane)) {
+      result.max_depth_mm = searched.max_depth_mm;
+      result.deepest_point = searched.first + searched.deepest_lane;
+    }
+    return true;
+  };
+  std::array<PendingDeepLeaf, kMaxPendingDeepLeaves> pending_deep;
+  std::size_t pending_count = 0;
   const auto count_depth = [&](std::uint32_t i, double depth) {
     ++result.penetrating_points;
     if (depth > result.max_depth_mm) {
@@ -293,10 +427,58 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     torque_sum += settled.sums.torque;
     return LeafVisit::Continue;
   };
-  const Walk walk =
-      walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf, visit_region_leaf);
+  // A leaf wholly deeper than the tolerance: every point counted, the force from its moments, its
+  // deepest point looked for after the walk if its bound may beat what the walk found.
+  const auto visit_deep_leaf = [&](const geometry::BoxClassification& cover, const tables::LeafBlock& block) {
+    const geometry::ImplicitSurface& surface = part.tool.surfaces[part.tool.regions[cover.region].surface];
+    const std::uint32_t leaf_index = static_cast<std::uint32_t>(&block - part.leaves);
+    // Finite: the walk found the leaf deep from this surface's finite numbers, and the loader checked
+    // the block's.
+    const LeafMomentForce moment = leaf_moment_force(surface, block, pose.tip_mm, centre, k_world);
+    if (!moment.settled) {
+      return LeafVisit::Visit;
+    }
+    force_sum += moment.force;
+    torque_sum += moment.torque;
+    const double bound = may_beat(cover.deepest_bound_mm, block.first_point)
+                             ? std::min(cover.deepest_bound_mm, sphere_deepest_bound(surface, block, pose.tip_mm))
+                             : cover.deepest_bound_mm;
+    if (may_beat(bound, block.first_point)) {
+      if (pending_count == pending_deep.size()) {
+        if (!search_deepest(leaf_index, cover.region)) {
+          return LeafVisit::Fault;
+        }
+      } else {
+        pending_deep[pending_count++] = {leaf_index, cover.region, bound};
+      }
+    }
+    result.penetrating_points += block.point_count;
+    return LeafVisit::Continue;
+  };
+  const Walk walk = walk_points_in_tool(part, part.tool, pose, Wanted::Penetrating, visit_point, visit_leaf,
+                                        visit_region_leaf, visit_deep_leaf);
   if (walk == Walk::BadTree) {
     return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  }
+  // The deep leaves' deepest points, best bound first, until no bound left can beat the deepest.
+  while (pending_count > 0) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < pending_count; ++i) {
+      // As deep a bound and earlier in the points' order first: the tie goes to the earlier point.
+      if (pending_deep[i].deepest_bound_mm > pending_deep[best].deepest_bound_mm ||
+          (pending_deep[i].deepest_bound_mm == pending_deep[best].deepest_bound_mm &&
+           pending_deep[i].leaf < pending_deep[best].leaf)) {
+        best = i;
+      }
+    }
+    const PendingDeepLeaf next = pending_deep[best];
+    if (!may_beat(next.deepest_bound_mm, part.leaves[next.leaf].first_point)) {
+      break;
+    }
+    pending_deep[best] = pending_deep[--pending_count];
+    if (!search_deepest(next.leaf, next.region)) {
+      return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    }
   }
   const double magnitude = force_sum.norm();
   if (magnitude > 0.0) {
@@ -320,7 +502,8 @@ Legality check_legal(const tables::PartTables& part, const ToolPose& pose) {
       visit_leaf,
       [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
         return settle_region_leaf(part.tool, cover, leaf, visit_leaf);
-      });
+      },
+      [](const geometry::BoxClassification&, const tables::LeafBlock&) { return LeafVisit::Stop; });  // every point penetrates
   switch (walk) {
     case Walk::Finished:
       return Legality::Legal;
@@ -356,7 +539,9 @@ std::uint32_t mark_touched(const tables::PartTables& part, const geometry::ToolB
       visit_leaf,
       [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
         return settle_region_leaf(contact_tool, cover, leaf, visit_leaf);
-      }));
+      },
+      // Never called: the touched set wants the points on the surface too, so every leaf is visited.
+      [](const geometry::BoxClassification&, const tables::LeafBlock&) { return LeafVisit::Fault; }));
   return static_cast<std::uint32_t>(touched.count() - before);
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <limits>
 
 #if defined(__AVX2__)
 #include <immintrin.h>
@@ -656,6 +657,58 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
   out.sums = leaf_forces(leaf, k_world, centre_height_mm);
   return true;
 #endif
+}
+
+LeafMomentForce leaf_moment_force(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
+                                  const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& centre, double k_world) {
+  const LeafMomentForce visit{false, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  const Eigen::Vector3d mean_normal(block.mean_normal[0], block.mean_normal[1], block.mean_normal[2]);
+  if (mean_normal.squaredNorm() < (1.0 - kMomentError) * (1.0 - kMomentError)) {
+    return visit;  // normals that differ: a leaf across an edge, or on a curved face
+  }
+  const Eigen::Vector3d centroid(block.centroid_mm[0], block.centroid_mm[1], block.centroid_mm[2]);
+  const Eigen::Vector3d offset = centroid - tip_mm;
+  const double r = std::sqrt(offset.x() * offset.x() + offset.y() * offset.y());
+  const geometry::MeridianPoint meridian{r, offset.z()};
+  const double depth = geometry::interior_distance(surface, meridian);
+  // The escape direction's radius of curvature at the centroid (squared): it turns about the axis
+  // with r, and about a sphere's or a torus tube's centre with the distance to it.
+  double curvature_radius_sq = std::numeric_limits<double>::infinity();
+  switch (surface.kind) {
+    case geometry::SurfaceKind::PlaneZ:
+      break;
+    case geometry::SurfaceKind::Cylinder:
+      curvature_radius_sq = r * r;
+      break;
+    case geometry::SurfaceKind::Sphere: {  // centred on the axis: the distance to its centre alone
+      const double dz = offset.z() - surface.center_z_mm;
+      curvature_radius_sq = r * r + dz * dz;
+      break;
+    }
+    case geometry::SurfaceKind::Torus: {
+      const double dr = r - surface.center_r_mm;
+      const double dz = offset.z() - surface.center_z_mm;
+      curvature_radius_sq = std::min(r * r, dr * dr + dz * dz);
+      break;
+    }
+  }
+  const double spread_sq = 0.25 * double{block.radius_mm} * double{block.radius_mm};
+  // sigma^2 / (L d) + sigma^2 / (2 L^2) <= kMomentError, multiplied out (L may be infinite).
+  if (!(depth > 0.0) ||
+      !(spread_sq * (2.0 * std::sqrt(curvature_radius_sq) + depth) <= 2.0 * kMomentError * curvature_radius_sq * depth)) {
+    return visit;
+  }
+  const geometry::MeridianDirection escape = geometry::escape_direction(surface, meridian);
+  // Radially out along (x, y) / r, or along +y on the axis, as the lanes and classify_at_pose turn it.
+  const Eigen::Vector3d radial = r > 1e-12 ? Eigen::Vector3d(offset.x() / r, offset.y() / r, 0.0)
+                                           : Eigen::Vector3d::UnitY();
+  const Eigen::Vector3d direction = mean_normal - (escape.radial * radial + escape.axial * Eigen::Vector3d::UnitZ());
+  const double length = direction.norm();
+  if (!(length >= kNoDirection)) {
+    return {true, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  }
+  const Eigen::Vector3d force = (k_world * static_cast<double>(block.point_count) * depth / length) * direction;
+  return {true, force, (centroid - centre).cross(force)};
 }
 
 }  // namespace stencil::engine

@@ -102,4 +102,25 @@ struct RegionLeafForce {
                                      bool find_deepest, double k_world, double centre_height_mm,
                                      LeafContacts& leaf, RegionLeafForce& out);
 
+// A leaf wholly deeper than the tolerance, from its moments: its points' count times the region's
+// depth at their centroid, along the normalised difference of their mean normal and the region's
+// escape direction there; the torque of that force at the centroid. About the centroid the first
+// order of the depth's and the direction's change over the leaf cancels, so this differs from the
+// sum of the points' forces by the second order: relatively about sigma^2 / (L d) and
+// sigma^2 / L^2, where sigma (about half the leaf's radius) is the points' spread, d the depth and L
+// the radius of curvature of the escape directions there (the distance to the surface's centre or
+// axis; a plane has none), and by the spread of the normals (1 - |mean normal|). A leaf is settled
+// so only where each is under kMomentError; any other is visited point by point (`settled` false).
+// The query settles a leaf so when its box says every point is deeper than the tolerance in one
+// region (so the count and the deepest depth stay exact); `surface` is that region's.
+inline constexpr double kMomentError = 0.05;
+struct LeafMomentForce {
+  bool settled;
+  Eigen::Vector3d force;
+  Eigen::Vector3d torque;
+};
+[[nodiscard]] LeafMomentForce leaf_moment_force(const geometry::ImplicitSurface& surface,
+                                                const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
+                                                const Eigen::Vector3d& centre, double k_world);
+
 }  // namespace stencil::engine

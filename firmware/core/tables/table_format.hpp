@@ -31,7 +31,9 @@ inline constexpr std::uint8_t kTableMagic[8] = {'S', 'T', 'E', 'N', 'C', 'I', 'L
 // leaves to classify for the same points (deep-corner query at 1e6 points: 387,939 instructions
 // against 483,828 with 32). The loader refuses older tables by name, with "regenerate with
 // stencil-tablegen".
-inline constexpr std::uint32_t kTableFormatVersion = 3;
+// 4: each leaf's block also holds its points' centroid and their normals' mean (LeafMoments), so
+// the query settles a leaf wholly deeper than the tolerance without visiting its points.
+inline constexpr std::uint32_t kTableFormatVersion = 4;
 inline constexpr std::size_t kSectionAlignment = 64;
 inline constexpr std::size_t kCrcStartOffset = 20;
 
@@ -143,8 +145,9 @@ static_assert(offsetof(BvhNode, first_point) == 112);
 // 32-byte aligned in the file), lanes past point_count repeating the last point, so every lane
 // holds a real point. The points are the very floats of the Points section, so a verdict taken
 // in double precision from a lane is the one taken from the point. The sphere bounds every point of
-// the leaf in double precision (checked by the loader; not yet used by the query: it is there for
-// settling a whole leaf from its distance to a tool surface).
+// the leaf in double precision (checked by the loader): the query bounds the depth of every point
+// of the leaf from the depth of its centre, and settles a leaf that lies wholly deeper than the
+// tolerance from its moments (tables/leaf_moments.hpp) without visiting its points.
 struct LeafBlock {
   float x_mm[kMaxLeafPoints];
   float y_mm[kMaxLeafPoints];
@@ -156,10 +159,13 @@ struct LeafBlock {
   std::uint32_t point_count;
   float centre_mm[3];         // every point within radius_mm of it (in double precision)
   float radius_mm;
-  std::uint8_t reserved[40];
+  float centroid_mm[3];       // tables::leaf_moments of the block, bit for bit (the loader checks)
+  float mean_normal[3];
+  std::uint8_t reserved[16];
 };
 static_assert(sizeof(LeafBlock) == 1600 && sizeof(LeafBlock) % 64 == 0, "blocks stay 64-byte aligned in the file");
 static_assert(offsetof(LeafBlock, nx) == 768 && offsetof(LeafBlock, first_point) == 1536);
+static_assert(offsetof(LeafBlock, centroid_mm) == 1560 && offsetof(LeafBlock, reserved) == 1584);
 
 // The tool's BSP tree in the file: the fields of geometry::ToolBsp, each byte defined.
 struct ToolSectionSurface {

@@ -10,6 +10,7 @@
 
 #include "firmware/core/geometry/kdop14.hpp"
 #include "firmware/core/geometry/tool_bsp_builder.hpp"
+#include "firmware/core/tables/leaf_moments.hpp"
 #include "firmware/core/tables/tool_section.hpp"
 
 namespace stencil::tables {
@@ -22,7 +23,7 @@ TableLoadResult ok() { return {true, nullptr, nullptr, 0, 0.0}; }
 
 }  // namespace
 
-const char* const kOlderVersion = "format version 3 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
+const char* const kOlderVersion = "format version 4 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
 
 namespace {
 
@@ -84,11 +85,11 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
   }
   if (header.format_version != kTableFormatVersion) {
     // Earlier versions are tables this build could read once: they are to be made again, not repaired.
-    static_assert(kTableFormatVersion == 3, "the texts below name the version");
+    static_assert(kTableFormatVersion == 4, "the texts below name the version");
     return refuse("header.format_version",
                   header.format_version >= 1 && header.format_version < kTableFormatVersion
                       ? kOlderVersion
-                      : "format version 3 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
+                      : "format version 4 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
                   8, header.format_version);
   }
   if (header.header_bytes != sizeof(TableHeader)) {
@@ -238,6 +239,15 @@ TableLoadResult check_leaf_block(const PartTables& tables, const BvhNode& node, 
     }
     if ((to_vector(point) - centre).norm() > double{block.radius_mm}) {
       return refuse("leaves.sphere", "a sphere holding every point of the leaf", leaf, lane);
+    }
+  }
+  const LeafMoments moments = leaf_moments(block);
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    if (!same_float(block.centroid_mm[axis], moments.centroid_mm[axis])) {
+      return refuse("leaves.centroid", "the mean of the leaf's points", leaf, block.centroid_mm[axis]);
+    }
+    if (!same_float(block.mean_normal[axis], moments.mean_normal[axis])) {
+      return refuse("leaves.mean_normal", "the mean of the leaf's normals", leaf, block.mean_normal[axis]);
     }
   }
   for (const std::uint8_t byte : block.reserved) {
