@@ -38,7 +38,11 @@ struct ContactResult {
 // Every point within the tool at `pose`. Per penetrating point i, f_i = k_world * d_i along v_i,
 // the normalised average of the point's normal and minus the tool's escape direction; the sum is
 // rescaled to magnitude k_world * d_max (so stiffness does not grow with point density), and the
-// torque sum r_i x f_i about the compliance centre by the same factor.
+// torque sum r_i x f_i about the compliance centre by the same factor. The count, the deepest
+// point and its depth are exact (double precision); a leaf of the points' tree lying wholly deeper
+// than the tolerance adds its points' forces from its moments where their error estimate allows
+// (leaf_moment_force: at 1e6 points in the bench's deep corner the force's direction moves by
+// 0.14 degrees and its torque per newton by 0.014 mm against the points' own sum).
 [[nodiscard]] ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pose,
                                            const ContactParameters& parameters);
 
