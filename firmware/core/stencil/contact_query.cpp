@@ -151,6 +151,15 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   std::size_t size = 0;
   stack[size++] = {0, geometry::BoxCover::Mixed, 0};
   LeafContacts leaf;
+  // A deep leaf: settled by visit_deep_leaf from its block, or where that cannot, by its points.
+  const auto visit_deep = [&](const geometry::BoxClassification& deep_cover, const tables::LeafBlock& block) {
+    const LeafVisit visit = visit_deep_leaf(deep_cover, block);
+    if (visit != LeafVisit::Visit) {
+      return visit;
+    }
+    load_leaf(part, block, pose.tip_mm, leaf);
+    return visit_region_leaf(deep_cover, leaf);
+  };
   while (size > 0) {
     const Pending pending = stack[--size];
     const std::uint32_t index = pending.index;
@@ -199,30 +208,20 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
           }
         }
-        if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {
-          switch (visit_deep_leaf(cover, block)) {  // NaN bounds never get here
-            case LeafVisit::Continue:
-              continue;
-            case LeafVisit::Stop:
-              return Walk::Stopped;
-            case LeafVisit::Fault:
-              return Walk::BadTree;
-            case LeafVisit::Visit:
-              break;
+        if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {  // never NaN here
+          const LeafVisit visit = visit_deep(cover, block);
+          if (visit == LeafVisit::Continue) {
+            continue;
           }
+          return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
         load_leaf(part, block, pose.tip_mm, leaf);
         if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
-          switch (visit_region_leaf(cover, leaf)) {
-            case LeafVisit::Continue:
-              continue;
-            case LeafVisit::Stop:
-              return Walk::Stopped;
-            case LeafVisit::Fault:
-            case LeafVisit::Visit:
-              break;
+          const LeafVisit visit = visit_region_leaf(cover, leaf);
+          if (visit == LeafVisit::Continue) {
+            continue;
           }
-          return Walk::BadTree;
+          return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
         const bool finite = cover.cover == geometry::BoxCover::SplitAtZ ? split_leaf_contacts(tool, cover, leaf)
                                                                         : mixed_leaf_contacts(tool, leaf);
@@ -273,22 +272,10 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             block.first_point > part.point_count() || block.point_count > part.point_count() - block.first_point) {
           return Walk::BadTree;  // a block the loader would have refused
         }
-        LeafVisit visit = visit_deep_leaf(cover, block);
-        if (visit == LeafVisit::Visit) {
-          // Its points after all, with the subtree's bound (its own box is not looked at).
-          load_leaf(part, block, pose.tip_mm, leaf);
-          visit = visit_region_leaf(cover, leaf);
+        const LeafVisit visit = visit_deep(cover, block);  // with the subtree's bound: its own box is not looked at
+        if (visit != LeafVisit::Continue) {
+          return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
-        switch (visit) {
-          case LeafVisit::Continue:
-            continue;
-          case LeafVisit::Stop:
-            return Walk::Stopped;
-          case LeafVisit::Fault:
-          case LeafVisit::Visit:
-            break;
-        }
-        return Walk::BadTree;
       }
       continue;
     }

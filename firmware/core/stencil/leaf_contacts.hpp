@@ -106,13 +106,17 @@ struct RegionLeafForce {
 // depth at their centroid, along the normalised difference of their mean normal and the region's
 // escape direction there; the torque of that force at the centroid. About the centroid the first
 // order of the depth's and the direction's change over the leaf cancels, so this differs from the
-// sum of the points' forces by the second order: relatively about sigma^2 / (L d) and
-// sigma^2 / L^2, where sigma (about half the leaf's radius) is the points' spread, d the depth and L
-// the radius of curvature of the escape directions there (the distance to the surface's centre or
-// axis; a plane has none), and by the spread of the normals (1 - |mean normal|). A leaf is settled
-// so only where each is under kMomentError; any other is visited point by point (`settled` false).
-// The query settles a leaf so when its box says every point is deeper than the tolerance in one
-// region (so the count and the deepest depth stay exact); `surface` is that region's.
+// sum of the points' forces by the second order: relatively about sigma^2 / (L d) + sigma^2 / 2L^2,
+// where sigma (taken as half the leaf's radius) is the points' spread, d the depth at the centroid
+// and L the radius of curvature of the escape directions there (the distance to the surface's
+// centre, or to the axis where they turn about it; a plane has none), and by the spread of the
+// normals (1 - |mean normal|). A leaf is settled so only where both are under kMomentError; any
+// other is left to its points (`settled` false). The torque puts the force at the centroid: its
+// line of action stays within the leaf. The query asks this only of a leaf whose box says every
+// point is deeper than the tolerance in one region (so the count and the deepest depth stay
+// exact); `surface` is that region's. Measured at 1e6 points (stencil-bench's deep-corner pose):
+// the total force's direction 0.14 degrees and its torque per newton 0.014 mm from the points' own
+// sum, and 0.41 of the previous engine's instructions against 0.50 with every point visited.
 inline constexpr double kMomentError = 0.05;
 struct LeafMomentForce {
   bool settled;
