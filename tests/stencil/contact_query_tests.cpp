@@ -288,3 +288,83 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
     CHECK_TEXT(worst_lever < 0.05, tool_text);
   }
 }
+
+// A flat end 0.3 mm into the top face: every point under its bottom is exactly as deep as every
+// other, many whole leaves lie deeper than the tolerance (settled from their moments, their deepest
+// point searched after the walk), and the deepest point is still the walk's own answer, the first
+// of them in the points' order. Under a plane, with one normal, the moments give the points' own
+// force and torque: to the float lanes' rounding.
+TEST(ContactQueryOracle, AFlatBottomDeepInAFaceGivesTheFirstOfEquallyDeepPointsAndTheirOwnForce) {
+  tablegen::GeneratorOptions options = test::default_job_options(2);
+  options.tool = tablegen::parse_tool("flat:d=3", "");
+  options.spacing_mm = 0.04;
+  options.force = true;
+  const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+  tables::PartTables part{};
+  CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+  const ContactParameters parameters{};
+  const double k_world = 10.0;
+  const Eigen::Vector3d tip(25.3, 12.1, kTop_mm - 0.3);
+  const Eigen::Vector3d centre = tip + parameters.compliance_centre_mm * Eigen::Vector3d::UnitZ();
+  std::uint32_t count = 0;
+  std::uint32_t first_deepest = 0;
+  double deepest = 0.0;
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+  for (std::uint32_t i = 0; i < part.point_count(); ++i) {
+    const Eigen::Vector3d p(part.points[i].x_mm, part.points[i].y_mm, part.points[i].z_mm);
+    const auto c = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), p);
+    if (c.contact != geometry::PointContact::Penetrating) {
+      continue;
+    }
+    ++count;
+    if (c.depth_mm > deepest) {
+      deepest = c.depth_mm;
+      first_deepest = i;
+    }
+    const tables::PackedPoint normal = tables::point_normal(part, i);
+    const Eigen::Vector3d f =
+        k_world * c.depth_mm * (Eigen::Vector3d(normal.x_mm, normal.y_mm, normal.z_mm) - c.escape_direction).normalized();
+    force += f;
+    torque += (p - centre).cross(f);
+  }
+  const ContactResult result = query_contacts(part, upright_at(tip.x(), tip.y(), tip.z()), parameters);
+  CHECK(count > 1000);
+  LONGS_EQUAL(count, result.penetrating_points);
+  DOUBLES_EQUAL(deepest, result.max_depth_mm, 0.0);
+  LONGS_EQUAL(first_deepest, result.deepest_point);
+  const double scale = k_world * deepest / force.norm();
+  CHECK((result.force_n - scale * force).norm() < 1e-5 * result.force_n.norm());
+  CHECK((result.torque_nmm - scale * torque).norm() < 1e-5 * (scale * torque).norm() + 1e-9);
+}
+
+// A ball end 0.5 mm into the top face: its deepest point lies under its centre, in a leaf wholly
+// deeper than the tolerance and settled from its moments, so the query finds it only in the search
+// after the walk; it is the point-by-point answer, and so are the count and the depth.
+TEST(ContactQueryOracle, ABallDeepInAFaceFindsItsDeepestPointInALeafSettledFromItsMoments) {
+  tablegen::GeneratorOptions options = test::default_job_options(2);
+  options.tool = tablegen::parse_tool("ball:d=3", "");
+  options.spacing_mm = 0.025;  // leaves small enough against the ball's curvature to be settled so
+  options.force = true;
+  const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+  tables::PartTables part{};
+  CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+  const Eigen::Vector3d tip(25.3, 12.1, kTop_mm - 0.5);
+  std::uint32_t count = 0;
+  std::uint32_t first_deepest = 0;
+  double deepest = 0.0;
+  for (std::uint32_t i = 0; i < part.point_count(); ++i) {
+    const Eigen::Vector3d p(part.points[i].x_mm, part.points[i].y_mm, part.points[i].z_mm);
+    const auto c = geometry::classify_at_pose(part.tool, tip, Eigen::Vector3d::UnitZ(), p);
+    if (c.contact == geometry::PointContact::Penetrating) {
+      ++count;
+      first_deepest = c.depth_mm > deepest ? i : first_deepest;
+      deepest = std::max(deepest, c.depth_mm);
+    }
+  }
+  const ContactResult result = query_contacts(part, upright_at(tip.x(), tip.y(), tip.z()), ContactParameters{});
+  CHECK(count > 1000);
+  LONGS_EQUAL(count, result.penetrating_points);
+  DOUBLES_EQUAL(deepest, result.max_depth_mm, 0.0);
+  LONGS_EQUAL(first_deepest, result.deepest_point);
+}

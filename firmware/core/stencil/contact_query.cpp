@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <limits>
 
 #include <Eigen/Geometry>
 
@@ -64,8 +63,10 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // query computes its force in the same pass) and answers a LeafVisit; the split and mixed ones go
 // settled to visit_leaf. For any other axis each point goes through classify_at_pose and
 // visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
-// block, for its normal). visit_point and visit_leaf stop the walk by returning false. Iterative,
-// with a fixed stack as deep as the loader allows trees to be.
+// block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
+// penetrating points are wanted, a leaf whose box lies wholly deeper than the tolerance in one
+// region, and every leaf under a node whose box does, goes first to visit_deep_leaf (below).
+// Iterative, with a fixed stack as deep as the loader allows trees to be.
 enum class Wanted : std::uint8_t {
   Penetrating,  // only points deeper than the tolerance matter (force, legality)
   InTool,       // points on the surface matter too (touched triangles)
@@ -76,7 +77,7 @@ enum class LeafVisit : std::uint8_t {
   Continue,
   Stop,
   Fault,
-  Visit,  // (visit_deep_leaf) the block's own numbers do not settle it: visit its points after all
+  LoadPoints,  // (visit_deep_leaf) the block's own numbers do not settle it: visit its points after all
 };
 
 // A leaf wholly in one region (or in it or outside), its lanes settled, given to visit_leaf: the
@@ -137,10 +138,11 @@ bool leaves_below(const tables::PartTables& part, std::uint32_t index, LeafRun& 
   return false;
 }
 
-// A leaf settled in one region whose shallowest point (by its box) is deeper than the tolerance
-// has every point penetrating, all in that region: when only penetrating points are wanted, the
-// walk gives it to visit_deep_leaf(cover, block) unloaded, which settles it from the block's own
-// numbers (its count, sphere and moments) without visiting its points.
+// A leaf settled in one region whose shallowest point (by its box, or its subtree's) is deeper than
+// the tolerance has every point penetrating, all in that region: when only penetrating points are
+// wanted, the walk gives it to visit_deep_leaf(cover, block) unloaded, which settles it from the
+// block's own numbers (its count, sphere and moments) or answers LoadPoints, and the walk then
+// loads it and gives it to visit_region_leaf as any leaf in one region.
 template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf, typename VisitDeepLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
                          Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf,
@@ -154,7 +156,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   // A deep leaf: settled by visit_deep_leaf from its block, or where that cannot, by its points.
   const auto visit_deep = [&](const geometry::BoxClassification& deep_cover, const tables::LeafBlock& block) {
     const LeafVisit visit = visit_deep_leaf(deep_cover, block);
-    if (visit != LeafVisit::Visit) {
+    if (visit != LeafVisit::LoadPoints) {
       return visit;
     }
     load_leaf(part, block, pose.tip_mm, leaf);
@@ -174,7 +176,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
     const bool settled = pending.settled != geometry::BoxCover::Mixed;
     geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
-    double shallowest_mm = -1.0;  // of a box settled in one region: no point is shallower (known when settled)
+    double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
     if (settled) {
       const geometry::DepthRange range =
           geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
@@ -208,7 +210,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
             shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
           }
         }
-        if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {  // never NaN here
+        if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {  // false for NaN
           const LeafVisit visit = visit_deep(cover, block);
           if (visit == LeafVisit::Continue) {
             continue;
@@ -351,6 +353,27 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   };
   std::array<PendingDeepLeaf, kMaxPendingDeepLeaves> pending_deep;
   std::size_t pending_count = 0;
+  // The pending leaf with the deepest bound (as deep a bound and earlier in the points' order
+  // first: the tie goes to the earlier point). pending_count > 0.
+  const auto best_pending = [&]() {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < pending_count; ++i) {
+      if (pending_deep[i].deepest_bound_mm > pending_deep[best].deepest_bound_mm ||
+          (pending_deep[i].deepest_bound_mm == pending_deep[best].deepest_bound_mm &&
+           pending_deep[i].leaf < pending_deep[best].leaf)) {
+        best = i;
+      }
+    }
+    return best;
+  };
+  // Takes that leaf off the list and searches it if it may still beat the deepest found (once it
+  // cannot, it never can: the deepest only grows). False on a fault.
+  const auto settle_best_pending = [&]() {
+    const std::size_t best = best_pending();
+    const PendingDeepLeaf next = pending_deep[best];
+    pending_deep[best] = pending_deep[--pending_count];
+    return !may_beat(next.deepest_bound_mm, part.leaves[next.leaf].first_point) || search_deepest(next.leaf, next.region);
+  };
   const auto count_depth = [&](std::uint32_t i, double depth) {
     ++result.penetrating_points;
     if (depth > result.max_depth_mm) {
@@ -423,21 +446,20 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     // the block's.
     const LeafMomentForce moment = leaf_moment_force(surface, block, pose.tip_mm, centre, k_world);
     if (!moment.settled) {
-      return LeafVisit::Visit;
+      return LeafVisit::LoadPoints;
     }
     force_sum += moment.force;
     torque_sum += moment.torque;
     const double bound = may_beat(cover.deepest_bound_mm, block.first_point)
                              ? std::min(cover.deepest_bound_mm, sphere_deepest_bound(surface, block, pose.tip_mm))
                              : cover.deepest_bound_mm;
+    // A full list makes room by settling its best leaf (which also raises the deepest found, so
+    // fewer leaves are pushed after it) rather than searching each leaf from then on.
+    if (may_beat(bound, block.first_point) && pending_count == pending_deep.size() && !settle_best_pending()) {
+      return LeafVisit::Fault;
+    }
     if (may_beat(bound, block.first_point)) {
-      if (pending_count == pending_deep.size()) {
-        if (!search_deepest(leaf_index, cover.region)) {
-          return LeafVisit::Fault;
-        }
-      } else {
-        pending_deep[pending_count++] = {leaf_index, cover.region, bound};
-      }
+      pending_deep[pending_count++] = {leaf_index, cover.region, bound};
     }
     result.penetrating_points += block.point_count;
     return LeafVisit::Continue;
@@ -448,22 +470,14 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   }
   // The deep leaves' deepest points, best bound first, until no bound left can beat the deepest.
+  // At most kMaxPendingDeepLeaves rounds, each a scan of the list: cheaper than sorting it in the
+  // usual case of one or two searches.
   while (pending_count > 0) {
-    std::size_t best = 0;
-    for (std::size_t i = 1; i < pending_count; ++i) {
-      // As deep a bound and earlier in the points' order first: the tie goes to the earlier point.
-      if (pending_deep[i].deepest_bound_mm > pending_deep[best].deepest_bound_mm ||
-          (pending_deep[i].deepest_bound_mm == pending_deep[best].deepest_bound_mm &&
-           pending_deep[i].leaf < pending_deep[best].leaf)) {
-        best = i;
-      }
-    }
-    const PendingDeepLeaf next = pending_deep[best];
+    const PendingDeepLeaf& next = pending_deep[best_pending()];
     if (!may_beat(next.deepest_bound_mm, part.leaves[next.leaf].first_point)) {
       break;
     }
-    pending_deep[best] = pending_deep[--pending_count];
-    if (!search_deepest(next.leaf, next.region)) {
+    if (!settle_best_pending()) {
       return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     }
   }

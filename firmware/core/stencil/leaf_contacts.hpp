@@ -110,7 +110,7 @@ struct RegionLeafForce {
 // where sigma (taken as half the leaf's radius) is the points' spread, d the depth at the centroid
 // and L the radius of curvature of the escape directions there (the distance to the surface's
 // centre, or to the axis where they turn about it; a plane has none), and by the spread of the
-// normals (1 - |mean normal|). A leaf is settled so only where both are under kMomentError; any
+// normals (1 - |mean normal|). A leaf is settled so only where both estimates are under kMomentError; any
 // other is left to its points (`settled` false). The torque puts the force at the centroid: its
 // line of action stays within the leaf. The query asks this only of a leaf whose box says every
 // point is deeper than the tolerance in one region (so the count and the deepest depth stay
