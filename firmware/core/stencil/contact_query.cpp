@@ -366,10 +366,9 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     }
     return best;
   };
-  // Takes that leaf off the list and searches it if it may still beat the deepest found (once it
-  // cannot, it never can: the deepest only grows). False on a fault.
-  const auto settle_best_pending = [&]() {
-    const std::size_t best = best_pending();
+  // Takes pending leaf `best` off the list and searches it if it may still beat the deepest found
+  // (once it cannot, it never can: the deepest only grows). False on a fault.
+  const auto settle_pending = [&](std::size_t best) {
     const PendingDeepLeaf next = pending_deep[best];
     pending_deep[best] = pending_deep[--pending_count];
     return !may_beat(next.deepest_bound_mm, part.leaves[next.leaf].first_point) || search_deepest(next.leaf, next.region);
@@ -455,7 +454,8 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
                              : cover.deepest_bound_mm;
     // A full list makes room by settling its best leaf (which also raises the deepest found, so
     // fewer leaves are pushed after it) rather than searching each leaf from then on.
-    if (may_beat(bound, block.first_point) && pending_count == pending_deep.size() && !settle_best_pending()) {
+    if (may_beat(bound, block.first_point) && pending_count == pending_deep.size() &&
+        !settle_pending(best_pending())) {
       return LeafVisit::Fault;
     }
     if (may_beat(bound, block.first_point)) {
@@ -473,11 +473,11 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   // At most kMaxPendingDeepLeaves rounds, each a scan of the list: cheaper than sorting it in the
   // usual case of one or two searches.
   while (pending_count > 0) {
-    const PendingDeepLeaf& next = pending_deep[best_pending()];
-    if (!may_beat(next.deepest_bound_mm, part.leaves[next.leaf].first_point)) {
+    const std::size_t best = best_pending();
+    if (!may_beat(pending_deep[best].deepest_bound_mm, part.leaves[pending_deep[best].leaf].first_point)) {
       break;
     }
-    if (!settle_best_pending()) {
+    if (!settle_pending(best)) {
       return {QueryStatus::BadTree, 0, 0.0, 0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
     }
   }
