@@ -37,6 +37,16 @@ void check_depth(const tables::PartTables& part, double true_depth, const Contac
   CHECK(result.max_depth_mm >= true_depth - part.header.gouge_bound_mm - 1e-5);
 }
 
+// The default part's table for `tool_text` at a fixed spacing (the gouge bound's would ask for
+// millions of points for a flat end); its bytes must outlive the tables loaded from them.
+tablegen::TableBytes table_at_spacing(const char* tool_text, double spacing_mm) {
+  tablegen::GeneratorOptions options = test::default_job_options(2);
+  options.tool = tablegen::parse_tool(tool_text, "");
+  options.spacing_mm = spacing_mm;
+  options.force = true;
+  return test::make_table(test::default_part(), options);
+}
+
 }  // namespace
 
 TEST_GROUP(ContactQuery) {
@@ -166,11 +176,7 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
   std::mt19937_64 random(404);
   std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (const char* tool_text : {"ball:d=3", "flat:d=3", "bull:d=4,r=1"}) {
-    tablegen::GeneratorOptions options = test::default_job_options(2);
-    options.tool = tablegen::parse_tool(tool_text, "");
-    options.spacing_mm = 0.08;  // a fixed spacing: a flat end's gouge bound would ask for millions
-    options.force = true;
-    const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+    const tablegen::TableBytes bytes = table_at_spacing(tool_text, 0.08);
     tables::PartTables part{};
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
     const ContactParameters parameters{};
@@ -295,11 +301,7 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
 // of them in the points' order. Under a plane, with one normal, the moments give the points' own
 // force and torque: to the float lanes' rounding.
 TEST(ContactQueryOracle, AFlatBottomDeepInAFaceGivesTheFirstOfEquallyDeepPointsAndTheirOwnForce) {
-  tablegen::GeneratorOptions options = test::default_job_options(2);
-  options.tool = tablegen::parse_tool("flat:d=3", "");
-  options.spacing_mm = 0.04;
-  options.force = true;
-  const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+  const tablegen::TableBytes bytes = table_at_spacing("flat:d=3", 0.04);
   tables::PartTables part{};
   CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
   const ContactParameters parameters{};
@@ -342,11 +344,8 @@ TEST(ContactQueryOracle, AFlatBottomDeepInAFaceGivesTheFirstOfEquallyDeepPointsA
 // deeper than the tolerance and settled from its moments, so the query finds it only in the search
 // after the walk; it is the point-by-point answer, and so are the count and the depth.
 TEST(ContactQueryOracle, ABallDeepInAFaceFindsItsDeepestPointInALeafSettledFromItsMoments) {
-  tablegen::GeneratorOptions options = test::default_job_options(2);
-  options.tool = tablegen::parse_tool("ball:d=3", "");
-  options.spacing_mm = 0.025;  // leaves small enough against the ball's curvature to be settled so
-  options.force = true;
-  const tablegen::TableBytes bytes = test::make_table(test::default_part(), options);
+  // Leaves small enough against the ball's curvature to be settled from their moments.
+  const tablegen::TableBytes bytes = table_at_spacing("ball:d=3", 0.025);
   tables::PartTables part{};
   CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
   const Eigen::Vector3d tip(25.3, 12.1, kTop_mm - 0.5);
