@@ -294,26 +294,15 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
 
 // The pending search for the deepest point of leaves settled whole (visit_deep_leaf): the query
 // counts and pushes such a leaf at once, but looks for its deepest point only after the walk, and
-// only while the leaf's bound can still beat the deepest point found, best bound first; a leaf the
-// list has no room for is searched at once. 256 is past the deepest contact the bench measures
-// (206 such leaves at 1e6 points in the deep corner).
+// only while the leaf's bound can still beat the deepest point found, best bound first; a full list
+// makes room by settling its best leaf at once. 256 is past the deepest contact the bench measures
+// (100 such leaves at 1e6 points in the deep corner).
 inline constexpr std::size_t kMaxPendingDeepLeaves = 256;
 struct PendingDeepLeaf {
   std::uint32_t leaf;
   std::uint8_t region;
   double deepest_bound_mm;
 };
-
-// The deepest any point of the leaf can be inside `surface`: its sphere's centre's depth plus its
-// radius (the depth is a distance, so it changes no faster than the point moves), with a margin
-// for the rounding of that one depth.
-double sphere_deepest_bound(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
-                            const Eigen::Vector3d& tip_mm) {
-  const Eigen::Vector3d offset =
-      Eigen::Vector3d(block.centre_mm[0], block.centre_mm[1], block.centre_mm[2]) - tip_mm;
-  const geometry::MeridianPoint meridian{std::sqrt(offset.x() * offset.x() + offset.y() * offset.y()), offset.z()};
-  return geometry::interior_distance(surface, meridian) + double{block.radius_mm} + 1e-9;
-}
 
 // The normal of `point`, of the leaf whose block is `block`.
 Eigen::Vector3d normal_of(const tables::LeafBlock& block, std::uint32_t point) {
@@ -450,7 +439,7 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     force_sum += moment.force;
     torque_sum += moment.torque;
     const double bound = may_beat(cover.deepest_bound_mm, block.first_point)
-                             ? std::min(cover.deepest_bound_mm, sphere_deepest_bound(surface, block, pose.tip_mm))
+                             ? std::min(cover.deepest_bound_mm, leaf_deepest_bound(surface, block, pose.tip_mm))
                              : cover.deepest_bound_mm;
     // A full list makes room by settling its best leaf (which also raises the deepest found, so
     // fewer leaves are pushed after it) rather than searching each leaf from then on.

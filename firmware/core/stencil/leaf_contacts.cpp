@@ -659,6 +659,28 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
 #endif
 }
 
+namespace {
+
+// A point of the block (its centroid or its sphere's centre) as the upright tool at tip_mm sees it.
+struct BlockPoint {
+  Eigen::Vector3d point;   // world mm
+  Eigen::Vector3d offset;  // from the tip
+  geometry::MeridianPoint meridian;
+};
+BlockPoint block_point(const float (&point_mm)[3], const Eigen::Vector3d& tip_mm) {
+  const Eigen::Vector3d point(point_mm[0], point_mm[1], point_mm[2]);
+  const Eigen::Vector3d offset = point - tip_mm;
+  return {point, offset, {std::sqrt(offset.x() * offset.x() + offset.y() * offset.y()), offset.z()}};
+}
+
+}  // namespace
+
+double leaf_deepest_bound(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
+                          const Eigen::Vector3d& tip_mm) {
+  return geometry::interior_distance(surface, block_point(block.centre_mm, tip_mm).meridian) +
+         double{block.radius_mm} + 1e-9;
+}
+
 LeafMomentForce leaf_moment_force(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
                                   const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& centre, double k_world) {
   const LeafMomentForce visit{false, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
@@ -666,10 +688,10 @@ LeafMomentForce leaf_moment_force(const geometry::ImplicitSurface& surface, cons
   if (mean_normal.squaredNorm() < (1.0 - kMomentError) * (1.0 - kMomentError)) {
     return visit;  // normals that differ: a leaf across an edge, or on a curved face
   }
-  const Eigen::Vector3d centroid(block.centroid_mm[0], block.centroid_mm[1], block.centroid_mm[2]);
-  const Eigen::Vector3d offset = centroid - tip_mm;
-  const double r = std::sqrt(offset.x() * offset.x() + offset.y() * offset.y());
-  const geometry::MeridianPoint meridian{r, offset.z()};
+  const BlockPoint at_centroid = block_point(block.centroid_mm, tip_mm);
+  const Eigen::Vector3d& offset = at_centroid.offset;
+  const geometry::MeridianPoint meridian = at_centroid.meridian;
+  const double r = meridian.r_mm;
   const double depth = geometry::interior_distance(surface, meridian);
   // The escape direction's radius of curvature at the centroid (squared): it turns about the axis
   // with r, and about a sphere's or a torus tube's centre with the distance to it.
@@ -708,7 +730,7 @@ LeafMomentForce leaf_moment_force(const geometry::ImplicitSurface& surface, cons
     return {true, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
   }
   const Eigen::Vector3d force = (k_world * static_cast<double>(block.point_count) * depth / length) * direction;
-  return {true, force, (centroid - centre).cross(force)};
+  return {true, force, (at_centroid.point - centre).cross(force)};
 }
 
 }  // namespace stencil::engine

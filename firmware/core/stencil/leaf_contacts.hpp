@@ -127,4 +127,11 @@ struct LeafMomentForce {
                                                 const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                                                 const Eigen::Vector3d& centre, double k_world);
 
+
+// The deepest any point of the leaf can be inside `surface`: its sphere's centre's depth plus its
+// radius (the depth is a distance, so it changes no faster than the point moves), with a margin
+// for the rounding of that one depth.
+[[nodiscard]] double leaf_deepest_bound(const geometry::ImplicitSurface& surface, const tables::LeafBlock& block,
+                                        const Eigen::Vector3d& tip_mm);
+
 }  // namespace stencil::engine
