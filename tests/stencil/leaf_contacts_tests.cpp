@@ -410,6 +410,88 @@ TEST(LeafContacts, TheOnePassForceSettlesLanesOnTheSurfaceInDoublePrecisionAsThe
   check_against_the_tree(tool, points, settled);
 }
 
+namespace {
+
+// split_leaf_force against split_leaf_contacts then leaf_forces, likewise.
+void check_one_pass_split_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                                          const LeafContacts& loaded) {
+  LeafContacts step_by_step = loaded;
+  CHECK(split_leaf_contacts(tool, cover, step_by_step));
+  const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
+  CHECK(step_by_step.penetrating > 0);
+  for (const bool find_deepest : {true, false}) {
+    LeafContacts leaf = loaded;
+    RegionLeafForce one_pass{};
+    CHECK(split_leaf_force(tool, cover, find_deepest, 10.0, 7.5, leaf, one_pass));
+    LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
+    DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
+    LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
+    CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
+    CHECK(sums.torque == one_pass.sums.torque);
+  }
+}
+
+}  // namespace
+
+TEST(LeafContacts, TheOnePassForceOfALeafSplitAtAPlaneIsTheStepByStepOneBitForBit) {
+  // Leaves across the plane between the ball and the flutes: inside both, across both surfaces
+  // (some lanes within the band of them), and near the axis; and across the plane of the holder's
+  // step, one side of it outside the tool.
+  const std::array<std::pair<Eigen::Vector3d, Eigen::Vector3d>, 5> leaves{{
+      {{1.3, 0.0, 1.5}, {0.05, 0.05, 0.1}},
+      {{1.05, 1.05, 1.5}, {0.08, 0.08, 0.2}},
+      {{0.1, 0.2, 1.5}, {0.1, 0.1, 0.3}},
+      {{1.6, 0.0, 12.0}, {0.1, 0.1, 0.3}},
+      {{3.0, 0.5, 20.0}, {0.1, 0.1, 0.3}},
+  }};
+  std::uint32_t splits = 0, with_an_outside_side = 0, straddling = 0;
+  for (const auto& [centre, half] : leaves) {
+    for (const std::uint32_t count : {tables::kMaxLeafPoints, 13U}) {
+      const LeafPoints points(centre, half, count);
+      const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+      if (cover.cover != geometry::BoxCover::SplitAtZ) {
+        continue;
+      }
+      ++splits;
+      with_an_outside_side += cover.below.cover == geometry::BoxCover::Outside ||
+                                      cover.above.cover == geometry::BoxCover::Outside ? 1U : 0U;
+      straddling += cover.below.cover == geometry::BoxCover::RegionOrOutside ||
+                            cover.above.cover == geometry::BoxCover::RegionOrOutside ? 1U : 0U;
+      load_leaf(points.part, points.packed(), kTip, leaf);
+      check_one_pass_split_is_step_by_step(tool, cover, leaf);
+    }
+  }
+  LONGS_EQUAL(8, splits);  // all but the leaf at the flutes' end, which lies in one region
+  LONGS_EQUAL(2, with_an_outside_side);
+  LONGS_EQUAL(2, straddling);
+}
+
+TEST(LeafContacts, TheOnePassForceOfASplitLeafSettlesLanesOnEitherSurfaceInDoublePrecisionAsTheStepsDo) {
+  // Points on the ball's equator and the flutes' cylinder above it, to a float's rounding, every
+  // fourth one deep inside: lanes within the band of each side's surface.
+  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
+  std::uint32_t on_the_surface = 0;
+  for (std::uint32_t i = 0; i < points.count; ++i) {
+    const double t = static_cast<double>(i);
+    const double r = i % 4 == 0 ? 1.2 : 1.5;
+    const double azimuth = 0.3 * std::cos(0.7 * t);
+    const Eigen::Vector3d p = kTip + Eigen::Vector3d(r * std::cos(azimuth), r * std::sin(azimuth), 1.5 + 0.2 * std::sin(1.3 * t));
+    points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+    const geometry::PointClassification c =
+        geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(i));
+    const double depth = c.contact == geometry::PointContact::Outside ? -1.0 : c.depth_mm;
+    on_the_surface += std::abs(depth) < 3e-6 || c.contact == geometry::PointContact::Touching ? 1U : 0U;
+  }
+  CHECK_TEXT(on_the_surface > 8, "points within the lanes' band of the surface");
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::SplitAtZ);
+  load_leaf(points.part, points.packed(), kTip, leaf);
+  check_one_pass_split_is_step_by_step(tool, cover, leaf);
+  LeafContacts settled = leaf;
+  CHECK(split_leaf_contacts(tool, cover, settled));
+  check_against_the_tree(tool, points, settled);
+}
+
 TEST(LeafContacts, EveryLaneOfAFullLeafIsSettledAsTheTreeSettlesItsPoint) {
   // The lanes past 32 too: a leaf of kMaxLeafPoints points each way a leaf is settled.
   check_leaf(LeafPoints(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), tables::kMaxLeafPoints),
@@ -434,6 +516,19 @@ TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {
   load_leaf(points.part, points.packed(), kTip, leaf);
   RegionLeafForce out{};
   CHECK_FALSE(region_leaf_force(damaged, cover.region, false, true, 10.0, 7.5, leaf, out));
+}
+
+TEST(LeafContacts, ADamagedSurfaceOnEitherSideIsAFaultInTheOnePassSplitForceToo) {
+  const LeafPoints points(Eigen::Vector3d(1.3, 0.0, 1.5), Eigen::Vector3d(0.05, 0.05, 0.1), 24);
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::SplitAtZ);
+  load_leaf(points.part, points.packed(), kTip, leaf);
+  for (const geometry::BoxPart& side : {cover.below, cover.above}) {
+    geometry::ToolBsp damaged = tool;
+    damaged.surfaces[damaged.regions[side.region].surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
+    RegionLeafForce out{};
+    CHECK_FALSE(split_leaf_force(damaged, cover, true, 10.0, 7.5, leaf, out));
+  }
 }
 
 namespace {

@@ -59,9 +59,9 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // region or just straddles its boundary (no walk of the tool tree per point), from the two sides'
 // regions when it straddles a partition plane, point by point through the tool tree when it
 // straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it or
-// outside) goes loaded to visit_region_leaf(cover, leaf), which settles its lanes itself (the
-// query computes its force in the same pass) and answers a LeafVisit; the split and mixed ones go
-// settled to visit_leaf. For any other axis each point goes through classify_at_pose and
+// outside), or split between two at a plane, goes loaded to visit_region_leaf(cover, leaf), which
+// settles its lanes itself (the query computes its force in the same pass) and answers a
+// LeafVisit; a mixed one goes settled to visit_leaf. For any other axis each point goes through classify_at_pose and
 // visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
 // block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
 // penetrating points are wanted, a leaf whose box lies wholly deeper than the tolerance in one
@@ -80,12 +80,15 @@ enum class LeafVisit : std::uint8_t {
   LoadPoints,  // (visit_deep_leaf) the block's own numbers do not settle it: visit its points after all
 };
 
-// A leaf wholly in one region (or in it or outside), its lanes settled, given to visit_leaf: the
-// visit of a settled leaf for walkers that want every lane's verdict.
+// A leaf wholly in one region (or in it or outside), or split between two at a plane, its lanes
+// settled, given to visit_leaf: the visit of a settled leaf for walkers that want every lane's verdict.
 template <typename VisitLeaf>
 LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
                              LeafContacts& leaf, VisitLeaf& visit_leaf) {
-  if (!region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf)) {
+  const bool finite = cover.cover == geometry::BoxCover::SplitAtZ
+                          ? split_leaf_contacts(tool, cover, leaf)
+                          : region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
+  if (!finite) {
     return LeafVisit::Fault;
   }
   return visit_leaf(leaf) ? LeafVisit::Continue : LeafVisit::Stop;
@@ -218,16 +221,15 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
         load_leaf(part, block, pose.tip_mm, leaf);
-        if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
+        if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
+            cover.cover == geometry::BoxCover::SplitAtZ) {
           const LeafVisit visit = visit_region_leaf(cover, leaf);
           if (visit == LeafVisit::Continue) {
             continue;
           }
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
-        const bool finite = cover.cover == geometry::BoxCover::SplitAtZ ? split_leaf_contacts(tool, cover, leaf)
-                                                                        : mixed_leaf_contacts(tool, leaf);
-        if (!finite) {
+        if (!mixed_leaf_contacts(tool, leaf)) {
           return Walk::BadTree;
         }
         if (!visit_leaf(leaf)) {
@@ -404,13 +406,18 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
     torque_sum += sums.torque;
     return true;
   };
-  // A leaf in one region: its force in one pass over the lanes, and its deepest lane searched only
-  // when the box's bound says one of its points may be deeper than the deepest found so far.
+  // A leaf in one region, or split between two: its force in one pass over the lanes, and its
+  // deepest lane searched only when the box's bound says one of its points may be deeper than the
+  // deepest found so far.
   const auto visit_region_leaf = [&](const geometry::BoxClassification& cover, LeafContacts& leaf) {
     RegionLeafForce settled{};
-    if (!region_leaf_force(part.tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
-                           cover.deepest_bound_mm > result.max_depth_mm, k_world, parameters.compliance_centre_mm, leaf,
-                           settled)) {
+    const bool find_deepest = cover.deepest_bound_mm > result.max_depth_mm;
+    const bool finite =
+        cover.cover == geometry::BoxCover::SplitAtZ
+            ? split_leaf_force(part.tool, cover, find_deepest, k_world, parameters.compliance_centre_mm, leaf, settled)
+            : region_leaf_force(part.tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside,
+                                find_deepest, k_world, parameters.compliance_centre_mm, leaf, settled);
+    if (!finite) {
       return LeafVisit::Fault;
     }
     if (settled.penetrating == 0) {

@@ -539,68 +539,132 @@ SurfaceLanes surface_lanes(const SurfaceConstants& c, __m256 x, __m256 y, __m256
   return s;
 }
 
+// leaf_forces' arithmetic over eight lanes at a time, summed into eight partials per component.
+struct LaneForces {
+  __m256 k, height, no_direction;
+  __m256 fx = _mm256_setzero_ps(), fy = _mm256_setzero_ps(), fz = _mm256_setzero_ps();
+  __m256 tx = _mm256_setzero_ps(), ty = _mm256_setzero_ps(), tz = _mm256_setzero_ps();
+
+  LaneForces(double k_world, double centre_height_mm)
+      : k(splat(static_cast<float>(k_world))),
+        height(splat(static_cast<float>(centre_height_mm))),
+        no_direction(splat(static_cast<float>(kNoDirection))) {}
+
+  // Lanes base..base+7 of the leaf: offsets x, y, z, depth d (0 where it does not penetrate) and
+  // escape direction e.
+  [[gnu::always_inline]] inline void add(const LeafContacts& leaf, std::uint32_t base, __m256 x, __m256 y, __m256 z, __m256 d, const SurfaceLanes& e) {
+    const __m256 vx = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nx + base), e.ex);
+    const __m256 vy = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->ny + base), e.ey);
+    const __m256 vz = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nz + base), e.ez);
+    const __m256 length = _mm256_sqrt_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(vx, vx), _mm256_mul_ps(vy, vy)), _mm256_mul_ps(vz, vz)));
+    const __m256 scale = _mm256_and_ps(_mm256_cmp_ps(length, no_direction, _CMP_GE_OQ),
+                                       _mm256_div_ps(_mm256_mul_ps(k, d), length));
+    const __m256 lane_fx = _mm256_mul_ps(scale, vx), lane_fy = _mm256_mul_ps(scale, vy), lane_fz = _mm256_mul_ps(scale, vz);
+    const __m256 rz = _mm256_sub_ps(z, height);
+    fx = _mm256_add_ps(fx, lane_fx);
+    fy = _mm256_add_ps(fy, lane_fy);
+    fz = _mm256_add_ps(fz, lane_fz);
+    tx = _mm256_add_ps(tx, _mm256_sub_ps(_mm256_mul_ps(y, lane_fz), _mm256_mul_ps(rz, lane_fy)));
+    ty = _mm256_add_ps(ty, _mm256_sub_ps(_mm256_mul_ps(rz, lane_fx), _mm256_mul_ps(x, lane_fz)));
+    tz = _mm256_add_ps(tz, _mm256_sub_ps(_mm256_mul_ps(x, lane_fy), _mm256_mul_ps(y, lane_fx)));
+  }
+
+  [[nodiscard]] LeafForceSums sums() const {
+    return {Eigen::Vector3d(double{reduce_sum(fx)}, double{reduce_sum(fy)}, double{reduce_sum(fz)}),
+            Eigen::Vector3d(double{reduce_sum(tx)}, double{reduce_sum(ty)}, double{reduce_sum(tz)})};
+  }
+};
+
+// The depth of lanes past count is 0 (summarise): the mask of lanes base..base+7 below count.
+[[gnu::always_inline]] inline __m256 below_count(const LeafContacts& leaf, std::uint32_t base) {
+  const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+  return _mm256_castsi256_ps(_mm256_cmpgt_epi32(_mm256_set1_epi32(static_cast<int>(leaf.count)), index));
+}
+
+// summarise's search for the deepest lane: of the penetrating lanes, those whose float depth is
+// within twice the band of the largest, each in double precision (exact(lane)); the first at the
+// greatest depth. The candidates are picked eight lanes to a compare, the same test as lane by lane.
+template <typename ExactDepth>
+void find_deepest_lane(const LeafLanes& depths, float band, LaneMask penetrating, ExactDepth&& exact,
+                       RegionLeafForce& out) {
+  const __m256 floor = splat(lane_max(depths) - 2.0F * band);
+  LaneMask near_deepest = 0;
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    near_deepest |= static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_load_ps(depths.data() + base), floor, _CMP_GE_OQ)))
+                    << base;
+  }
+  for_each_lane(near_deepest & penetrating, [&](std::uint32_t lane) {
+    const double depth = exact(lane);
+    if (depth > out.max_depth_mm) {
+      out.max_depth_mm = depth;
+      out.deepest_lane = lane;
+    }
+  });
+}
+
+// One region's verdicts on eight lanes (surface_contacts' second loop): the depth where it
+// penetrates beyond the tolerance, else 0; the lanes in `check_lanes` whose float depth is within
+// the band settled again in double precision (`depths` is scratch for them). Adds the lanes'
+// function and escape to `check` and sets their bits in `penetrating`.
+struct RegionVerdicts {
+  const geometry::ImplicitSurface* surface;
+  __m256 minus_sign, tolerance, band, no_sign;
+};
+[[gnu::always_inline]] inline __m256 region_depths(const RegionVerdicts& v, const LeafContacts& leaf, std::uint32_t base, const SurfaceLanes& s,
+                     LaneMask check_lanes, __m256& check, LaneMask& penetrating, LeafLanes& depths) {
+  const __m256 depth = _mm256_mul_ps(v.minus_sign, s.f);
+  const __m256 deeper = _mm256_cmp_ps(depth, v.tolerance, _CMP_GT_OQ);
+  __m256 d = _mm256_and_ps(deeper, depth);
+  check = _mm256_add_ps(check, _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(s.f, s.ex), s.ey), s.ez));
+  penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
+  const LaneMask uncertain =
+      (static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(depth, v.no_sign), v.band, _CMP_LE_OQ)))
+       << base) & check_lanes;
+  if (uncertain != 0) {
+    _mm256_store_ps(depths.data() + base, d);
+    for_each_lane(uncertain, [&](std::uint32_t lane) {
+      const double exact = exact_depth(leaf, lane, *v.surface);
+      const bool is_deeper = exact > geometry::kSurfaceTolerance_mm;
+      depths[lane] = is_deeper ? static_cast<float>(exact) : 0.0F;
+      penetrating = is_deeper ? penetrating | (LaneMask{1} << lane) : penetrating & ~(LaneMask{1} << lane);
+    });
+    d = _mm256_load_ps(depths.data() + base);
+  }
+  return d;
+}
+
+SurfaceConstants constants_of(const geometry::ImplicitSurface& surface) {
+  const float sign = surface.solid_side == geometry::SolidSide::Below ? 1.0F : -1.0F;
+  return {splat(sign), splat(static_cast<float>(surface.center_z_mm)), splat(static_cast<float>(surface.center_r_mm)),
+          splat(static_cast<float>(surface.radius_mm))};
+}
+
+RegionVerdicts verdicts_of(const geometry::ImplicitSurface& surface, float band) {
+  const float sign = surface.solid_side == geometry::SolidSide::Below ? 1.0F : -1.0F;
+  return {&surface, splat(-sign), splat(kTolerance_mm), splat(band), _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff))};
+}
+
 template <SurfaceKind Kind>
 bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deepest, double k_world,
                         double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
-  const float sign = surface.solid_side == geometry::SolidSide::Below ? 1.0F : -1.0F;
-  const SurfaceConstants c{splat(sign), splat(static_cast<float>(surface.center_z_mm)),
-                           splat(static_cast<float>(surface.center_r_mm)), splat(static_cast<float>(surface.radius_mm))};
+  const SurfaceConstants c = constants_of(surface);
   const float band = band_for(leaf, surface);
-  const __m256 minus_sign = splat(-sign), tolerance = splat(kTolerance_mm), band_lanes = splat(band);
-  const __m256 no_sign = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  const __m256 k = splat(static_cast<float>(k_world)), height = splat(static_cast<float>(centre_height_mm));
-  const __m256 no_direction = splat(static_cast<float>(kNoDirection));
-  const __m256i count = _mm256_set1_epi32(static_cast<int>(leaf.count));
+  const RegionVerdicts verdicts = verdicts_of(surface, band);
   const LaneMask valid = lanes_below(leaf.count);
   alignas(32) LeafLanes depths;
   __m256 check = _mm256_setzero_ps();
-  __m256 fx_sum = _mm256_setzero_ps(), fy_sum = _mm256_setzero_ps(), fz_sum = _mm256_setzero_ps();
-  __m256 tx_sum = _mm256_setzero_ps(), ty_sum = _mm256_setzero_ps(), tz_sum = _mm256_setzero_ps();
+  LaneForces forces(k_world, centre_height_mm);
   LaneMask penetrating = 0;
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
     const __m256 x = _mm256_load_ps(leaf.x.data() + base);
     const __m256 y = _mm256_load_ps(leaf.y.data() + base);
     const __m256 z = _mm256_load_ps(leaf.z.data() + base);
     const SurfaceLanes s = surface_lanes<Kind>(c, x, y, z);
-    // surface_contacts' second loop: the verdicts, and the sum that tells a non-finite lane.
-    const __m256 depth = _mm256_mul_ps(minus_sign, s.f);
-    const __m256 deeper = _mm256_cmp_ps(depth, tolerance, _CMP_GT_OQ);
-    __m256 d = _mm256_and_ps(deeper, depth);
-    check = _mm256_add_ps(check, _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(s.f, s.ex), s.ey), s.ez));
-    penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
-    const LaneMask uncertain =
-        (static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(depth, no_sign), band_lanes, _CMP_LE_OQ)))
-         << base) & valid;
-    if (uncertain != 0) {
-      _mm256_store_ps(depths.data() + base, d);
-      for_each_lane(uncertain, [&](std::uint32_t lane) {
-        const double exact = exact_depth(leaf, lane, surface);
-        const bool is_deeper = exact > geometry::kSurfaceTolerance_mm;
-        depths[lane] = is_deeper ? static_cast<float>(exact) : 0.0F;
-        penetrating = is_deeper ? penetrating | (LaneMask{1} << lane) : penetrating & ~(LaneMask{1} << lane);
-      });
-      d = _mm256_load_ps(depths.data() + base);
-    }
-    // summarise: no depth past count.
-    const __m256i index = _mm256_add_epi32(_mm256_set1_epi32(static_cast<int>(base)), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
-    d = _mm256_and_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(count, index)), d);
+    const __m256 d = _mm256_and_ps(below_count(leaf, base),
+                                   region_depths(verdicts, leaf, base, s, valid, check, penetrating, depths));
     _mm256_store_ps(depths.data() + base, d);
-    // leaf_forces.
-    const __m256 vx = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nx + base), s.ex);
-    const __m256 vy = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->ny + base), s.ey);
-    const __m256 vz = _mm256_sub_ps(_mm256_loadu_ps(leaf.normals->nz + base), s.ez);
-    const __m256 length = _mm256_sqrt_ps(
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(vx, vx), _mm256_mul_ps(vy, vy)), _mm256_mul_ps(vz, vz)));
-    const __m256 scale = _mm256_and_ps(_mm256_cmp_ps(length, no_direction, _CMP_GE_OQ),
-                                       _mm256_div_ps(_mm256_mul_ps(k, d), length));
-    const __m256 fx = _mm256_mul_ps(scale, vx), fy = _mm256_mul_ps(scale, vy), fz = _mm256_mul_ps(scale, vz);
-    const __m256 rz = _mm256_sub_ps(z, height);
-    fx_sum = _mm256_add_ps(fx_sum, fx);
-    fy_sum = _mm256_add_ps(fy_sum, fy);
-    fz_sum = _mm256_add_ps(fz_sum, fz);
-    tx_sum = _mm256_add_ps(tx_sum, _mm256_sub_ps(_mm256_mul_ps(y, fz), _mm256_mul_ps(rz, fy)));
-    ty_sum = _mm256_add_ps(ty_sum, _mm256_sub_ps(_mm256_mul_ps(rz, fx), _mm256_mul_ps(x, fz)));
-    tz_sum = _mm256_add_ps(tz_sum, _mm256_sub_ps(_mm256_mul_ps(x, fy), _mm256_mul_ps(y, fx)));
+    forces.add(leaf, base, x, y, z, d, s);
   }
   if (!std::isfinite(reduce_sum(check))) {
     return false;
@@ -609,19 +673,113 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
   out.max_depth_mm = 0.0;
   out.deepest_lane = 0;
   if (find_deepest && out.penetrating > 0) {
-    const float floor = lane_max(depths) - 2.0F * band;
-    for_each_lane(penetrating & valid, [&](std::uint32_t lane) {
-      if (depths[lane] >= floor) {
-        const double depth = exact_depth(leaf, lane, surface);
-        if (depth > out.max_depth_mm) {
-          out.max_depth_mm = depth;
-          out.deepest_lane = lane;
-        }
-      }
-    });
+    find_deepest_lane(depths, band, penetrating & valid, [&](std::uint32_t lane) { return exact_depth(leaf, lane, surface); },
+                      out);
   }
-  out.sums = {Eigen::Vector3d(double{reduce_sum(fx_sum)}, double{reduce_sum(fy_sum)}, double{reduce_sum(fz_sum)}),
-              Eigen::Vector3d(double{reduce_sum(tx_sum)}, double{reduce_sum(ty_sum)}, double{reduce_sum(tz_sum)})};
+  out.sums = forces.sums();
+  return true;
+}
+
+[[gnu::always_inline]] inline SurfaceLanes any_surface_lanes(SurfaceKind kind, const SurfaceConstants& c, __m256 x, __m256 y, __m256 z) {
+  switch (kind) {
+    case SurfaceKind::PlaneZ:
+      return surface_lanes<SurfaceKind::PlaneZ>(c, x, y, z);
+    case SurfaceKind::Cylinder:
+      return surface_lanes<SurfaceKind::Cylinder>(c, x, y, z);
+    case SurfaceKind::Sphere:
+      return surface_lanes<SurfaceKind::Sphere>(c, x, y, z);
+    case SurfaceKind::Torus:
+      break;
+  }
+  return surface_lanes<SurfaceKind::Torus>(c, x, y, z);
+}
+
+// One side of a split leaf: its region's surface (none: outside the tool) and its verdicts so far.
+struct SplitSide {
+  const geometry::ImplicitSurface* surface;
+  float band;  // 0 with no surface: split_leaf_contacts' maximum of the two sides' bands
+  SurfaceConstants c;
+  RegionVerdicts verdicts;
+  __m256 check = _mm256_setzero_ps();
+  LaneMask penetrating = 0;
+
+  SplitSide(const geometry::ImplicitSurface* side_surface, const LeafContacts& leaf)
+      : surface(side_surface),
+        band(side_surface != nullptr ? band_for(leaf, *side_surface) : 0.0F),
+        c(side_surface != nullptr ? constants_of(*side_surface) : SurfaceConstants{}),
+        verdicts(side_surface != nullptr ? verdicts_of(*side_surface, band) : RegionVerdicts{}) {}
+
+  // Depth and escape of lanes base..base+7 from this side's surface (zero with none, as
+  // clear_contacts leaves them); of its own lanes, `mine`, those on the surface settled in double
+  // precision as surface_contacts settles them (the other side's lanes are not used).
+  __m256 lanes(const LeafContacts& leaf, std::uint32_t base, __m256 x, __m256 y, __m256 z, LaneMask mine,
+               LeafLanes& depths, SurfaceLanes& s) {
+    if (surface == nullptr) {
+      s = {_mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps(), _mm256_setzero_ps()};
+      return _mm256_setzero_ps();
+    }
+    s = any_surface_lanes(surface->kind, c, x, y, z);
+    return region_depths(verdicts, leaf, base, s, mine, check, penetrating, depths);
+  }
+
+  [[nodiscard]] bool finite() const { return surface == nullptr || std::isfinite(reduce_sum(check)); }
+};
+
+// split_leaf_contacts then leaf_forces, in one pass: each lane takes its own side's depth and
+// escape, then the force of region_force_lanes.
+bool split_force_lanes(const geometry::ImplicitSurface* below_surface, const geometry::ImplicitSurface* above_surface,
+                       double split_z_mm, bool find_deepest, double k_world, double centre_height_mm,
+                       const LeafContacts& leaf, RegionLeafForce& out) {
+  SplitSide below(below_surface, leaf), above(above_surface, leaf);
+  const LaneMask valid = lanes_below(leaf.count);
+  // classify_meridian's partition test, on the same double-precision z: below when z - split < 0
+  // (the block's lanes are the points' own floats).
+  const __m256d tip_z = _mm256_set1_pd(leaf.tip_mm.z()), split_z = _mm256_set1_pd(split_z_mm);
+  const auto below_split = [&](__m128 four_z) {
+    return _mm256_movemask_pd(_mm256_cmp_pd(_mm256_sub_pd(_mm256_sub_pd(_mm256_cvtps_pd(four_z), tip_z), split_z),
+                                            _mm256_setzero_pd(), _CMP_LT_OQ));
+  };
+  const __m256i lane_bit = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+  alignas(32) LeafLanes depths;
+  LaneForces forces(k_world, centre_height_mm);
+  LaneMask is_below = 0;
+  for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    const __m256 x = _mm256_load_ps(leaf.x.data() + base);
+    const __m256 y = _mm256_load_ps(leaf.y.data() + base);
+    const __m256 z = _mm256_load_ps(leaf.z.data() + base);
+    const __m256 point_z = _mm256_loadu_ps(leaf.normals->z_mm + base);
+    const auto chunk = static_cast<std::uint32_t>(below_split(_mm256_castps256_ps128(point_z)) |
+                                                  (below_split(_mm256_extractf128_ps(point_z, 1)) << 4));
+    const LaneMask chunk_below = (static_cast<LaneMask>(chunk) << base) & valid;
+    is_below |= chunk_below;
+    SurfaceLanes below_lanes{}, above_lanes{};
+    const __m256 below_d = below.lanes(leaf, base, x, y, z, chunk_below, depths, below_lanes);
+    const __m256 above_d = above.lanes(leaf, base, x, y, z, valid & ~chunk_below, depths, above_lanes);
+    const __m256i chunk_bits = _mm256_set1_epi32(static_cast<int>(chunk_below >> base));
+    const __m256 take_below = _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(chunk_bits, lane_bit), lane_bit));
+    const SurfaceLanes s{_mm256_setzero_ps(), _mm256_blendv_ps(above_lanes.ex, below_lanes.ex, take_below),
+                         _mm256_blendv_ps(above_lanes.ey, below_lanes.ey, take_below),
+                         _mm256_blendv_ps(above_lanes.ez, below_lanes.ez, take_below)};
+    const __m256 d = _mm256_and_ps(below_count(leaf, base), _mm256_blendv_ps(above_d, below_d, take_below));
+    _mm256_store_ps(depths.data() + base, d);
+    forces.add(leaf, base, x, y, z, d, s);
+  }
+  if (!below.finite() || !above.finite()) {
+    return false;
+  }
+  const LaneMask penetrating = ((below.penetrating & is_below) | (above.penetrating & ~is_below)) & valid;
+  out.penetrating = static_cast<std::uint32_t>(std::popcount(penetrating));
+  out.max_depth_mm = 0.0;
+  out.deepest_lane = 0;
+  if (find_deepest && out.penetrating > 0) {
+    // Only penetrating lanes are asked for, and those have a surface on their own side.
+    find_deepest_lane(depths, std::max(below.band, above.band), penetrating,
+                      [&](std::uint32_t lane) {
+                        return exact_depth(leaf, lane, ((is_below >> lane) & 1U) != 0 ? *below.surface : *above.surface);
+                      },
+                      out);
+  }
+  out.sums = forces.sums();
   return true;
 }
 #endif
@@ -649,6 +807,31 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
   // fused pass (its deepest lane is searched either way; the answer is the same).
   static_cast<void>(surface);
   if (!region_leaf_contacts(tool, region, or_outside, leaf)) {
+    return false;
+  }
+  out.penetrating = leaf.penetrating;
+  out.max_depth_mm = find_deepest ? leaf.max_depth_mm : 0.0;
+  out.deepest_lane = find_deepest ? leaf.deepest_lane : 0;
+  out.sums = leaf_forces(leaf, k_world, centre_height_mm);
+  return true;
+#endif
+}
+
+bool split_leaf_force(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover, bool find_deepest,
+                      double k_world, double centre_height_mm, LeafContacts& leaf, RegionLeafForce& out) {
+#if defined(__AVX2__)
+  const geometry::ImplicitSurface* below = part_surface(tool, cover.below);
+  const geometry::ImplicitSurface* above = part_surface(tool, cover.above);
+  const auto known = [](const geometry::ImplicitSurface* surface) {
+    return surface == nullptr || surface->kind == SurfaceKind::PlaneZ || surface->kind == SurfaceKind::Cylinder ||
+           surface->kind == SurfaceKind::Sphere || surface->kind == SurfaceKind::Torus;
+  };
+  if (!known(below) || !known(above)) {
+    return false;  // as surface_contacts: a damaged tree
+  }
+  return split_force_lanes(below, above, cover.split_z_mm, find_deepest, k_world, centre_height_mm, leaf, out);
+#else
+  if (!split_leaf_contacts(tool, cover, leaf)) {
     return false;
   }
   out.penetrating = leaf.penetrating;

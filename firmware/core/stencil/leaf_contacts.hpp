@@ -102,6 +102,13 @@ struct RegionLeafForce {
                                      bool find_deepest, double k_world, double centre_height_mm,
                                      LeafContacts& leaf, RegionLeafForce& out);
 
+// split_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (loaded by
+// load_leaf) straddles the partition plane of `cover` (SplitAtZ), each lane settled by its own
+// side's region. The same numbers, bit for bit, as the two steps, as region_leaf_force gives.
+[[nodiscard]] bool split_leaf_force(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
+                                    bool find_deepest, double k_world, double centre_height_mm, LeafContacts& leaf,
+                                    RegionLeafForce& out);
+
 // A leaf wholly deeper than the tolerance, from its moments: its points' count times the region's
 // depth at their centroid, along the normalised difference of their mean normal and the region's
 // escape direction there; the torque of that force at the centroid. About the centroid the first
