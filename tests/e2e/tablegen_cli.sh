@@ -533,18 +533,18 @@ case_inspect_refuses_non_finite_point_with_a_valid_crc() {
 case_inspect_refuses_wrong_format_version() {
   make_table
   cp good.stbl version.stbl
-  put_u32 version.stbl 8 5  # a version after this build's (4)
+  put_u32 version.stbl 8 6  # a version after this build's (5)
   tablegen --inspect version.stbl
   expect_status 2
   expect_stderr_names_file version.stbl
   expect_stderr 'header\.format_version' "the field header.format_version"
 }
 
-# A table of format version 1 (before the packed leaves), 2 (leaves of 32 points) or 3 (no leaf
-# moments) is to be made again, in those words.
+# A table of format version 1 (before the packed leaves), 2 (leaves of 32 points), 3 (no leaf
+# moments) or 4 (no group moments) is to be made again, in those words.
 case_inspect_of_an_older_table_says_regenerate() {
   make_table
-  for version in 1 2 3; do
+  for version in 1 2 3 4; do
     cp good.stbl old.stbl
     put_u32 old.stbl 8 "$version"
     tablegen --inspect old.stbl

@@ -540,14 +540,23 @@ struct MomentLeaf {
   std::array<tables::PackedPoint, tables::kMaxLeafPoints> points{};
   tables::LeafBlock block{};
 
-  MomentLeaf(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius, const Eigen::Vector3d& other) {
+  // With `grouped`, the disc is four discs of half the radius, one to each group of lanes (as the
+  // generator orders a leaf's points), each a sunflower of its own.
+  MomentLeaf(const Eigen::Vector3d& centre, const Eigen::Vector3d& normal, double radius, const Eigen::Vector3d& other,
+             bool grouped = false) {
     const Eigen::Vector3d u = normal.unitOrthogonal();
     const Eigen::Vector3d v = normal.cross(u);
     block.point_count = tables::kMaxLeafPoints;
     for (std::uint32_t i = 0; i < tables::kMaxLeafPoints; ++i) {
-      const double t = static_cast<double>(i);
-      const double s = radius * std::sqrt((t + 0.5) / tables::kMaxLeafPoints);  // a sunflower: even cover
-      const Eigen::Vector3d p = kTip + centre + s * (std::cos(2.39996 * t) * u + std::sin(2.39996 * t) * v);
+      const std::uint32_t group = i / tables::kLeafGroupPoints;
+      const double t = static_cast<double>(grouped ? i % tables::kLeafGroupPoints : i);
+      const double points_in_disc = grouped ? tables::kLeafGroupPoints : tables::kMaxLeafPoints;
+      const double disc = grouped ? 0.5 * radius : radius;
+      const Eigen::Vector3d middle =
+          grouped ? Eigen::Vector3d(0.5 * radius * ((group & 1U) != 0 ? 0.7 : -0.7) * u + 0.5 * radius * ((group & 2U) != 0 ? 0.7 : -0.7) * v)
+                  : Eigen::Vector3d::Zero();
+      const double s = disc * std::sqrt((t + 0.5) / points_in_disc);  // a sunflower: even cover
+      const Eigen::Vector3d p = kTip + centre + middle + s * (std::cos(2.39996 * t) * u + std::sin(2.39996 * t) * v);
       points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
       const Eigen::Vector3d n = i % 2 == 0 ? normal : other;
       block.x_mm[i] = points[i].x_mm;
@@ -569,6 +578,13 @@ struct MomentLeaf {
     const tables::LeafMoments moments = tables::leaf_moments(block);
     std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
     std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
+    for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
+      for (std::size_t axis = 0; axis < 3; ++axis) {
+        block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
+        block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
+      }
+      block.group_radius_mm[group] = moments.groups[group].radius_mm;
+    }
   }
 
   [[nodiscard]] Eigen::Vector3d point(std::uint32_t i) const {
@@ -653,4 +669,50 @@ TEST(LeafContacts, ALeafSmallAgainstTheBallsCurvatureIsSettledNearItsSumAndAWide
   const MomentLeaf wide(where, normal, 0.4, normal);
   static_cast<void>(sums_point_by_point(tool, wide, k, centre));  // still wholly inside, in the ball
   CHECK_FALSE(leaf_moment_force(surface, wide.block, kTip, centre, k).settled);
+}
+
+// The same wide leaf with its points in four compact groups (as the generator orders them): too
+// wide for its own moments, each group small enough for its own, and their sum near the points'.
+TEST(LeafContacts, ALeafTooWideForItsOwnMomentsIsSettledFromItsGroupsNearItsSum) {
+  const double k = 10.0;
+  const Eigen::Vector3d centre = kTip + Eigen::Vector3d(0.0, 0.0, 10.0);
+  const Eigen::Vector3d where(0.4, 0.3, 1.0);
+  const Eigen::Vector3d normal = Eigen::Vector3d(-0.3, 0.5, 1.0).normalized();
+  const MomentLeaf grouped(where, normal, 0.4, normal, true);
+  const PointSums exact = sums_point_by_point(tool, grouped, k, centre);
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[exact.region].surface];
+  MomentLeaf whole_only = grouped;  // the same leaf without its groups' moments: refused
+  std::fill(std::begin(whole_only.block.group_mean_normal[0]), std::end(whole_only.block.group_mean_normal[0]), 0.0F);
+  std::fill(std::begin(whole_only.block.group_mean_normal[1]), std::end(whole_only.block.group_mean_normal[1]), 0.0F);
+  std::fill(std::begin(whole_only.block.group_mean_normal[2]), std::end(whole_only.block.group_mean_normal[2]), 0.0F);
+  CHECK_FALSE(leaf_moment_force(surface, whole_only.block, kTip, centre, k).settled);
+  const LeafMomentForce moment = leaf_moment_force(surface, grouped.block, kTip, centre, k);
+  CHECK(moment.settled);
+  CHECK((moment.force - exact.sums.force).norm() < kMomentError * exact.sums.force.norm());
+  CHECK((moment.force - exact.sums.force).norm() > 1e-7 * exact.sums.force.norm());
+  // Each group's force at its own centroid: the torque per newton within the leaf's radius.
+  CHECK((moment.torque - exact.sums.torque).norm() < double{grouped.block.radius_mm} * exact.sums.force.norm());
+  // One group across an edge (its normals two ways): the leaf is visited, not settled.
+  MomentLeaf edge = grouped;
+  for (std::size_t axis = 0; axis < 3; ++axis) {  // the mean of its normals and +x's
+    edge.block.group_mean_normal[axis][2] = 0.5F * (edge.block.group_mean_normal[axis][2] + (axis == 0 ? 1.0F : 0.0F));
+  }
+  CHECK_FALSE(leaf_moment_force(surface, edge.block, kTip, centre, k).settled);
+}
+
+// Where the part's normal is nearly the tool's escape direction, normalize(normal - escape) turns
+// with every small change of either: even a small leaf is left to its points.
+TEST(LeafContacts, ALeafWhoseNormalIsNearlyItsEscapeDirectionIsNotSettledFromItsMoments) {
+  const double k = 10.0;
+  const Eigen::Vector3d centre = kTip + Eigen::Vector3d(0.0, 0.0, 10.0);
+  const Eigen::Vector3d where(0.4, 0.3, 1.0);
+  const Eigen::Vector3d escape = (where - Eigen::Vector3d(0.0, 0.0, 1.5)).normalized();  // from the ball's centre
+  const Eigen::Vector3d normal = (escape + Eigen::Vector3d(0.0, 0.05, 0.0)).normalized();
+  const MomentLeaf small(where, normal, 0.08, normal);
+  const PointSums exact = sums_point_by_point(tool, small, k, centre);
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[exact.region].surface];
+  CHECK_FALSE(leaf_moment_force(surface, small.block, kTip, centre, k).settled);
+  const MomentLeaf facing(where, -escape, 0.08, -escape);  // the same leaf facing the tool: settled
+  static_cast<void>(sums_point_by_point(tool, facing, k, centre));
+  CHECK(leaf_moment_force(surface, facing.block, kTip, centre, k).settled);
 }

@@ -135,3 +135,40 @@ TEST(BvhBuilder, TheTreeIsTheSameWhateverTheThreads) {
   CHECK_EQUAL(one.nodes.size(), two.nodes.size());
   CHECK_EQUAL(0, std::memcmp(one.nodes.data(), two.nodes.data(), one.nodes.size() * sizeof(tables::BvhNode)));
 }
+
+TEST(BvhBuilder, EachGroupOfALeafsLanesIsAQuarterOfItsPointsAlongTheWidestSlab) {
+  // One leaf of points along a line, given in scrambled order: its groups of kLeafGroupPoints
+  // lanes are the lowest quarter, the next, and so on (each group in its own stretch of x).
+  std::vector<tables::PackedPoint> points;
+  for (std::uint32_t i = 0; i < tables::kMaxLeafPoints; ++i) {
+    points.push_back({static_cast<float>((i * 37U) % tables::kMaxLeafPoints), 0.5F, 0.0F});
+  }
+  const PointTree tree = build_point_tree(points, 1);
+  CHECK_EQUAL(1U, tree.nodes.size());
+  for (std::uint32_t slot = 0; slot < tables::kMaxLeafPoints; ++slot) {
+    const auto group = static_cast<float>(slot / tables::kLeafGroupPoints);
+    const float x = points[tree.order[slot]].x_mm;
+    CHECK(x >= group * static_cast<float>(tables::kLeafGroupPoints) &&
+          x < (group + 1.0F) * static_cast<float>(tables::kLeafGroupPoints));
+  }
+}
+
+TEST(BvhBuilder, AShortLeafHasWholeGroupsFirst) {
+  // 40 points: two full groups, then the last 8; each group's points in their own stretch of x.
+  constexpr std::uint32_t kCount = 40;
+  std::vector<tables::PackedPoint> points;
+  for (std::uint32_t i = 0; i < kCount; ++i) {
+    points.push_back({static_cast<float>((i * 17U) % kCount), 0.5F, 0.0F});
+  }
+  const PointTree tree = build_point_tree(points, 1);
+  std::vector<float> low(3, 1e9F), high(3, -1e9F);
+  for (std::uint32_t slot = 0; slot < kCount; ++slot) {
+    const std::uint32_t group = slot / tables::kLeafGroupPoints;
+    low[group] = std::min(low[group], points[tree.order[slot]].x_mm);
+    high[group] = std::max(high[group], points[tree.order[slot]].x_mm);
+  }
+  CHECK(high[0] < low[1] || high[1] < low[0]);
+  CHECK(high[0] < low[2] || high[2] < low[0]);
+  CHECK(high[1] < low[2] || high[2] < low[1]);
+  DOUBLES_EQUAL(7.0, double{high[2] - low[2]}, 0.0);  // the last 8 points: 8 consecutive x
+}

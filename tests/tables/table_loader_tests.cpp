@@ -152,14 +152,14 @@ TEST(TableLoader, RefusesTheWrongMagicVersionOrHeaderSize) {
   STRCMP_EQUAL("header.format_version", older.field);
   CHECK(older.expected == kOlderVersion);
   DOUBLES_EQUAL(1.0, older.value, 0.0);
-  // And one without the leaves' moments, the format before this one.
+  // And one without the groups' moments, the format before this one.
   header.format_version = kTableFormatVersion - 1;
   put_header(bytes, header);
   reseal(bytes);
   const TableLoadResult previous = load(bytes, tables);
   CHECK_FALSE(previous.ok);
   CHECK(previous.expected == kOlderVersion);
-  DOUBLES_EQUAL(3.0, previous.value, 0.0);
+  DOUBLES_EQUAL(4.0, previous.value, 0.0);
 
   bytes = copy_of(valid_table(), valid_table().size());
   header = header_of(bytes);
@@ -305,6 +305,25 @@ TEST(TableLoader, RefusesLeafBlocksThatAreNotTheirLeaves) {
   with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) {
     b[2].mean_normal[2] = std::nextafter(b[2].mean_normal[2], -1e9F);
   }, "leaves.mean_normal");
+  // Each group's moments likewise, and a group past the leaf's points must be zero.
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) {
+    b[1].group_centroid_mm[0][2] = std::nextafter(b[1].group_centroid_mm[0][2], 1e9F);
+  }, "leaves.group_centroid");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) {
+    b[0].group_mean_normal[1][1] = std::nextafter(b[0].group_mean_normal[1][1], -1e9F);
+  }, "leaves.group_mean_normal");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader&) {
+    b[2].group_radius_mm[0] = std::nextafter(b[2].group_radius_mm[0], 0.0F);  // one point outside it
+  }, "leaves.group_radius");
+  with_leaves([](LeafBlock* b, BvhNode*, const TableHeader& h) {
+    for (std::uint32_t leaf = 0; leaf < h.leaf_count; ++leaf) {
+      if (b[leaf].point_count <= (kLeafGroups - 1) * kLeafGroupPoints) {
+        b[leaf].group_radius_mm[kLeafGroups - 1] = 1.0F;
+        return;
+      }
+    }
+    b[0].group_radius_mm[0] += 1.0F;  // every leaf full: any change is refused alike
+  }, "leaves.group_radius");
   // Nodes numbering their blocks out of order, or an internal node naming one.
   with_leaves([](LeafBlock*, BvhNode* n, const TableHeader& h) {
     for (std::uint32_t i = 0; i < h.node_count; ++i) {

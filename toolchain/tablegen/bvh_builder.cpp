@@ -26,10 +26,7 @@ class TreeBuilder {
 
   // Builds the subtree over order[begin, end) into nodes starting at node_index.
   void build(std::uint32_t node_index, std::uint32_t begin, std::uint32_t end) {
-    geometry::Kdop14 volume = geometry::Kdop14::empty();
-    for (std::uint32_t i = begin; i < end; ++i) {
-      volume.add(to_vector(points_[tree_.order[i]]));
-    }
+    const geometry::Kdop14 volume = volume_of(begin, end);
     tables::BvhNode& node = tree_.nodes[node_index];
     std::memset(&node, 0, sizeof(node));
     std::copy(volume.min.begin(), volume.min.end(), node.dop_min);
@@ -38,9 +35,10 @@ class TreeBuilder {
     if (count <= tables::kMaxLeafPoints) {
       node.first_point = begin;
       node.point_count = count;
+      order_groups(volume, begin, end);
       return;
     }
-    const std::uint32_t middle = split(volume, begin, end);
+    const std::uint32_t middle = split(volume, begin, end, begin + static_cast<std::uint32_t>(point_tree_left_count(count)));
     const std::uint32_t left = node_index + 1;
     const std::uint32_t right = left + static_cast<std::uint32_t>(point_tree_node_count(middle - begin));
     node.right_child = right;
@@ -48,8 +46,30 @@ class TreeBuilder {
     build(right, middle, end);
   }
 
-  // Orders order[begin, end) so the lower half along the widest slab comes first; returns the middle.
-  std::uint32_t split(const geometry::Kdop14& volume, std::uint32_t begin, std::uint32_t end) {
+  // Orders a leaf's points so each group of kLeafGroupPoints lanes lies close together: halved
+  // along the widest slab at a whole number of groups, and each half again, down to one group (the
+  // query settles a group from its moments where the whole leaf is too wide for its own).
+  void order_groups(const geometry::Kdop14& volume, std::uint32_t begin, std::uint32_t end) {
+    const std::uint32_t count = end - begin;
+    if (count <= tables::kLeafGroupPoints) {
+      return;
+    }
+    const std::uint32_t groups = (count + tables::kLeafGroupPoints - 1) / tables::kLeafGroupPoints;
+    const std::uint32_t middle = split(volume, begin, end, begin + tables::kLeafGroupPoints * ((groups + 1) / 2));
+    order_groups(volume_of(begin, middle), begin, middle);
+    order_groups(volume_of(middle, end), middle, end);
+  }
+
+  geometry::Kdop14 volume_of(std::uint32_t begin, std::uint32_t end) const {
+    geometry::Kdop14 volume = geometry::Kdop14::empty();
+    for (std::uint32_t i = begin; i < end; ++i) {
+      volume.add(to_vector(points_[tree_.order[i]]));
+    }
+    return volume;
+  }
+
+  // Orders order[begin, end) so the points below `middle` are the lower ones along the widest slab.
+  std::uint32_t split(const geometry::Kdop14& volume, std::uint32_t begin, std::uint32_t end, std::uint32_t middle) {
     std::size_t widest = 0;
     double widest_extent = -1.0;
     for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
@@ -59,7 +79,6 @@ class TreeBuilder {
         widest = slab;
       }
     }
-    const auto middle = static_cast<std::uint32_t>(begin + point_tree_left_count(end - begin));
     const auto& direction = geometry::kKdopSlabDirections[widest];
     const auto key = [&](std::uint32_t index) {
       const tables::PackedPoint& point = points_[index];
@@ -110,7 +129,7 @@ PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsig
   for (const tables::PackedPoint& point : points) {
     volume.add(to_vector(point));
   }
-  const std::uint32_t middle = builder.split(volume, 0, count);
+  const std::uint32_t middle = builder.split(volume, 0, count, static_cast<std::uint32_t>(point_tree_left_count(count)));
   tables::BvhNode& root = tree.nodes[0];
   std::memset(&root, 0, sizeof(root));
   std::copy(volume.min.begin(), volume.min.end(), root.dop_min);

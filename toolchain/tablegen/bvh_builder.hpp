@@ -18,6 +18,8 @@ struct PointTree {
 // median (point_tree_left_count): every leaf but the last holds kMaxLeafPoints points, so the
 // query's 64-lane kernels run full and a tree has as few nodes as it can. The two halves of the
 // root are built on two threads when threads > 1; the result does not depend on `threads`.
+// Within a leaf, the points are ordered so that each group of kLeafGroupPoints lanes lies close
+// together (halved along the widest slab at a whole number of groups, down to one group).
 // The DOPs are computed from `points` exactly as given (the float values the table will hold).
 [[nodiscard]] PointTree build_point_tree(const std::vector<tables::PackedPoint>& points, unsigned threads);
 

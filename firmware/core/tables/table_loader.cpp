@@ -23,7 +23,7 @@ TableLoadResult ok() { return {true, nullptr, nullptr, 0, 0.0}; }
 
 }  // namespace
 
-const char* const kOlderVersion = "format version 4 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
+const char* const kOlderVersion = "format version 5 (an older format: regenerate the table with stencil-tablegen)";  // names kTableFormatVersion: see check_header
 
 namespace {
 
@@ -85,11 +85,11 @@ TableLoadResult check_header(std::span<const std::byte> bytes, const TableHeader
   }
   if (header.format_version != kTableFormatVersion) {
     // Earlier versions are tables this build could read once: they are to be made again, not repaired.
-    static_assert(kTableFormatVersion == 4, "the texts below name the version");
+    static_assert(kTableFormatVersion == 5, "the texts below name the version");
     return refuse("header.format_version",
                   header.format_version >= 1 && header.format_version < kTableFormatVersion
                       ? kOlderVersion
-                      : "format version 4 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
+                      : "format version 5 (not a version this build knows: from a newer stencil-tablegen, or damaged)",
                   8, header.format_version);
   }
   if (header.header_bytes != sizeof(TableHeader)) {
@@ -248,6 +248,23 @@ TableLoadResult check_leaf_block(const PartTables& tables, const BvhNode& node, 
     }
     if (!same_float(block.mean_normal[axis], moments.mean_normal[axis])) {
       return refuse("leaves.mean_normal", "the mean of the leaf's normals", leaf, block.mean_normal[axis]);
+    }
+  }
+  for (std::uint32_t group = 0; group < kLeafGroups; ++group) {
+    const LeafGroupMoments& expected = moments.groups[group];
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      if (!same_float(block.group_centroid_mm[axis][group], expected.centroid_mm[axis])) {
+        return refuse("leaves.group_centroid", "the mean of each group's points (0 past the leaf's points)", leaf,
+                      block.group_centroid_mm[axis][group]);
+      }
+      if (!same_float(block.group_mean_normal[axis][group], expected.mean_normal[axis])) {
+        return refuse("leaves.group_mean_normal", "the mean of each group's normals (0 past the leaf's points)", leaf,
+                      block.group_mean_normal[axis][group]);
+      }
+    }
+    if (!same_float(block.group_radius_mm[group], expected.radius_mm)) {
+      return refuse("leaves.group_radius", "each group's farthest point from its centroid, rounded up", leaf,
+                    block.group_radius_mm[group]);
     }
   }
   for (const std::uint8_t byte : block.reserved) {
