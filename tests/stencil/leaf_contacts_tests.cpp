@@ -33,6 +33,20 @@ namespace {
 const Eigen::Vector3d kTip(123.4375, 78.90625, 10.0625);
 constexpr geometry::ToolSpec kBall{geometry::CutterKind::Ball, 3.0, 12.0, 0.0, 10.0, 20.0};
 
+// The block's moments and its groups', as the generator writes them (the loader checks them).
+void with_moments(tables::LeafBlock& block) {
+  const tables::LeafMoments moments = tables::leaf_moments(block);
+  std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
+  std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
+  for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
+      block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
+    }
+    block.group_radius_mm[group] = moments.groups[group].radius_mm;
+  }
+}
+
 // A leaf's points in a box around `centre` (offsets from the tip), spread over it by a fixed
 // pattern, with normals pointing every which way (unit, never along the axis alone).
 struct LeafPoints {
@@ -71,6 +85,7 @@ struct LeafPoints {
       block.ny[lane] = normals[i].y_mm;
       block.nz[lane] = normals[i].z_mm;
     }
+    with_moments(block);
     return block;
   }
 
@@ -575,16 +590,7 @@ struct MomentLeaf {
       block.centre_mm[axis] = static_cast<float>(middle[axis]);
     }
     block.radius_mm = static_cast<float>(farthest * (1.0 + 1e-6));
-    const tables::LeafMoments moments = tables::leaf_moments(block);
-    std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
-    std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
-    for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
-      for (std::size_t axis = 0; axis < 3; ++axis) {
-        block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
-        block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
-      }
-      block.group_radius_mm[group] = moments.groups[group].radius_mm;
-    }
+    with_moments(block);
   }
 
   [[nodiscard]] Eigen::Vector3d point(std::uint32_t i) const {

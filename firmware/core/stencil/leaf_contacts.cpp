@@ -102,6 +102,14 @@ LaneMask pack(const LaneFlags& flags) {
 
 LaneMask lanes_below(std::uint32_t count) { return count >= kLanes ? ~LaneMask{0} : (LaneMask{1} << count) - 1U; }
 
+// How many points group `group` of the block has (0 past its points).
+std::uint32_t group_count(const tables::LeafBlock& block, std::uint32_t group) {
+  const std::uint32_t count = std::min(block.point_count, tables::kMaxLeafPoints);
+  const std::uint32_t first = group * tables::kLeafGroupPoints;
+  return first < count ? std::min(tables::kLeafGroupPoints, count - first) : 0U;
+}
+
+
 // Calls visit(lane) for each lane of the mask, lowest first.
 template <typename Visit>
 void for_each_lane(LaneMask mask, Visit&& visit) {
@@ -645,6 +653,75 @@ RegionVerdicts verdicts_of(const geometry::ImplicitSurface& surface, float band)
   return {&surface, splat(-sign), splat(kTolerance_mm), splat(band), _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff))};
 }
 
+// The block's four groups at their centroids, one to each double lane of an AVX register: the
+// offset from the tip, the distance r from the axis, and from the region's surface the depth, how
+// fast the escape direction turns (1 / its radius of curvature) and the escape direction, by the
+// same operations as block_point, interior_distance and escape_direction. Groups past the leaf's
+// points are zeros and give numbers of no meaning.
+struct GroupGeometry {
+  __m256d px, py, pz, ox, oy, oz, r, depth, curvature, escape_radial, escape_axial;
+};
+template <SurfaceKind Kind>
+[[gnu::always_inline]] inline GroupGeometry group_geometry(const geometry::ImplicitSurface& surface,
+                                                           const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm) {
+  static_assert(tables::kLeafGroups == 4, "one group to each double lane of an AVX register");
+  const auto lanes = [](const float (&four)[tables::kLeafGroups]) { return _mm256_cvtps_pd(_mm_loadu_ps(four)); };
+  const auto splat_d = [](double value) { return _mm256_set1_pd(value); };
+  const __m256d px = lanes(block.group_centroid_mm[0]), py = lanes(block.group_centroid_mm[1]),
+                pz = lanes(block.group_centroid_mm[2]);
+  const __m256d ox = _mm256_sub_pd(px, splat_d(tip_mm.x())), oy = _mm256_sub_pd(py, splat_d(tip_mm.y())),
+                oz = _mm256_sub_pd(pz, splat_d(tip_mm.z()));
+  const __m256d r = _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(ox, ox), _mm256_mul_pd(oy, oy)));
+  const double side = surface.solid_side == geometry::SolidSide::Below ? 1.0 : -1.0;
+  __m256d f, curvature, escape_radial, escape_axial;
+  if constexpr (Kind == SurfaceKind::PlaneZ) {
+    f = _mm256_sub_pd(oz, splat_d(surface.center_z_mm));
+    curvature = _mm256_setzero_pd();
+    escape_radial = _mm256_setzero_pd();
+    escape_axial = splat_d(side);
+  } else if constexpr (Kind == SurfaceKind::Cylinder) {
+    f = _mm256_sub_pd(r, splat_d(surface.radius_mm));
+    curvature = _mm256_div_pd(splat_d(1.0), r);
+    escape_radial = splat_d(side);
+    escape_axial = _mm256_setzero_pd();
+  } else {
+    const __m256d dr = _mm256_sub_pd(r, splat_d(Kind == SurfaceKind::Torus ? surface.center_r_mm : 0.0));
+    const __m256d dz = _mm256_sub_pd(oz, splat_d(surface.center_z_mm));
+    const __m256d tube = _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(dr, dr), _mm256_mul_pd(dz, dz)));
+    f = _mm256_sub_pd(tube, splat_d(surface.radius_mm));
+    const __m256d to_axis_sq = _mm256_mul_pd(r, r);
+    if constexpr (Kind == SurfaceKind::Sphere) {
+      curvature = _mm256_div_pd(splat_d(1.0), _mm256_sqrt_pd(_mm256_add_pd(to_axis_sq, _mm256_mul_pd(dz, dz))));
+    } else {  // std::min(r^2, dr^2 + dz^2): the second only where it is less
+      const __m256d to_tube_sq = _mm256_add_pd(_mm256_mul_pd(dr, dr), _mm256_mul_pd(dz, dz));
+      curvature = _mm256_div_pd(
+          splat_d(1.0),
+          _mm256_sqrt_pd(_mm256_blendv_pd(to_axis_sq, to_tube_sq, _mm256_cmp_pd(to_tube_sq, to_axis_sq, _CMP_LT_OQ))));
+    }
+    const __m256d degenerate = _mm256_cmp_pd(tube, splat_d(1e-12), _CMP_LT_OQ);  // escape_direction's
+    escape_radial = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(splat_d(side), dr), tube),
+                                     splat_d(0.70710678118654752440), degenerate);
+    escape_axial = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(splat_d(side), dz), tube),
+                                    splat_d(-0.70710678118654752440), degenerate);
+  }
+  return {px, py, pz, ox, oy, oz, r, _mm256_mul_pd(splat_d(-side), f), curvature, escape_radial, escape_axial};
+}
+
+// The groups of a leaf in one region that no point of can penetrate (its depth at the centroid
+// plus its radius, the depth changing no faster than the point moves, is within the tolerance),
+// and the groups past its points: bit g for group g.
+template <SurfaceKind Kind>
+[[gnu::always_inline]] inline unsigned shallow_groups(const geometry::ImplicitSurface& surface, const LeafContacts& leaf) {
+  const tables::LeafBlock& block = *leaf.normals;
+  const GroupGeometry g = group_geometry<Kind>(surface, block, leaf.tip_mm);
+  const __m256d deepest = _mm256_add_pd(_mm256_add_pd(g.depth, _mm256_cvtps_pd(_mm_loadu_ps(block.group_radius_mm))),
+                                        _mm256_set1_pd(1e-9));  // a margin for the rounding of the one depth
+  const unsigned shallow = static_cast<unsigned>(
+      _mm256_movemask_pd(_mm256_cmp_pd(deepest, _mm256_set1_pd(geometry::kSurfaceTolerance_mm), _CMP_LE_OQ)));
+  const unsigned groups = (leaf.count + tables::kLeafGroupPoints - 1) / tables::kLeafGroupPoints;
+  return shallow | (0xFU & ~((1U << groups) - 1U));
+}
+
 template <SurfaceKind Kind>
 bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deepest, double k_world,
                         double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
@@ -656,7 +733,14 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
   __m256 check = _mm256_setzero_ps();
   LaneForces forces(k_world, centre_height_mm);
   LaneMask penetrating = 0;
+  // A group that cannot penetrate adds nothing: its lanes' depths are 0 either way (within the
+  // band of the surface they would be settled in double precision, below it), so their forces.
+  const unsigned shallow = shallow_groups<Kind>(surface, leaf);
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
+    if (((shallow >> (base / tables::kLeafGroupPoints)) & 1U) != 0) {
+      _mm256_store_ps(depths.data() + base, _mm256_setzero_ps());
+      continue;
+    }
     const __m256 x = _mm256_load_ps(leaf.x.data() + base);
     const __m256 y = _mm256_load_ps(leaf.y.data() + base);
     const __m256 z = _mm256_load_ps(leaf.z.data() + base);
@@ -874,13 +958,6 @@ struct Moments {
   std::uint32_t count;
 };
 
-// How many points group `group` of the block has (0 past its points).
-std::uint32_t group_count(const tables::LeafBlock& block, std::uint32_t group) {
-  const std::uint32_t count = std::min(block.point_count, tables::kMaxLeafPoints);
-  const std::uint32_t first = group * tables::kLeafGroupPoints;
-  return first < count ? std::min(tables::kLeafGroupPoints, count - first) : 0U;
-}
-
 // leaf_moment_force of one set of points (below).
 LeafMomentForce moment_force(const geometry::ImplicitSurface& surface, const Moments& moments,
                              const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& centre, double k_world) {
@@ -944,44 +1021,9 @@ LeafMomentForce group_moment_lanes(const geometry::ImplicitSurface& surface, con
   const __m256d present = _mm256_cmp_pd(n, _mm256_setzero_pd(), _CMP_GT_OQ);
   const __m256d nx = lanes(block.group_mean_normal[0]), ny = lanes(block.group_mean_normal[1]),
                 nz = lanes(block.group_mean_normal[2]);
-  const __m256d px = lanes(block.group_centroid_mm[0]), py = lanes(block.group_centroid_mm[1]),
-                pz = lanes(block.group_centroid_mm[2]);
-  const __m256d ox = _mm256_sub_pd(px, splat_d(tip_mm.x())), oy = _mm256_sub_pd(py, splat_d(tip_mm.y())),
-                oz = _mm256_sub_pd(pz, splat_d(tip_mm.z()));
-  const __m256d r = _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(ox, ox), _mm256_mul_pd(oy, oy)));
-  const double side = surface.solid_side == geometry::SolidSide::Below ? 1.0 : -1.0;
-  __m256d f, curvature, escape_radial, escape_axial;
-  if constexpr (Kind == SurfaceKind::PlaneZ) {
-    f = _mm256_sub_pd(oz, splat_d(surface.center_z_mm));
-    curvature = _mm256_setzero_pd();
-    escape_radial = _mm256_setzero_pd();
-    escape_axial = splat_d(side);
-  } else if constexpr (Kind == SurfaceKind::Cylinder) {
-    f = _mm256_sub_pd(r, splat_d(surface.radius_mm));
-    curvature = _mm256_div_pd(splat_d(1.0), r);
-    escape_radial = splat_d(side);
-    escape_axial = _mm256_setzero_pd();
-  } else {
-    const __m256d dr = _mm256_sub_pd(r, splat_d(Kind == SurfaceKind::Torus ? surface.center_r_mm : 0.0));
-    const __m256d dz = _mm256_sub_pd(oz, splat_d(surface.center_z_mm));
-    const __m256d tube = _mm256_sqrt_pd(_mm256_add_pd(_mm256_mul_pd(dr, dr), _mm256_mul_pd(dz, dz)));
-    f = _mm256_sub_pd(tube, splat_d(surface.radius_mm));
-    const __m256d to_axis_sq = _mm256_mul_pd(r, r);
-    if constexpr (Kind == SurfaceKind::Sphere) {
-      curvature = _mm256_div_pd(splat_d(1.0), _mm256_sqrt_pd(_mm256_add_pd(to_axis_sq, _mm256_mul_pd(dz, dz))));
-    } else {  // std::min(r^2, dr^2 + dz^2): the second only where it is less
-      const __m256d to_tube_sq = _mm256_add_pd(_mm256_mul_pd(dr, dr), _mm256_mul_pd(dz, dz));
-      curvature = _mm256_div_pd(
-          splat_d(1.0),
-          _mm256_sqrt_pd(_mm256_blendv_pd(to_axis_sq, to_tube_sq, _mm256_cmp_pd(to_tube_sq, to_axis_sq, _CMP_LT_OQ))));
-    }
-    const __m256d degenerate = _mm256_cmp_pd(tube, splat_d(1e-12), _CMP_LT_OQ);  // escape_direction's
-    escape_radial = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(splat_d(side), dr), tube),
-                                     splat_d(0.70710678118654752440), degenerate);
-    escape_axial = _mm256_blendv_pd(_mm256_div_pd(_mm256_mul_pd(splat_d(side), dz), tube),
-                                    splat_d(-0.70710678118654752440), degenerate);
-  }
-  const __m256d depth = _mm256_mul_pd(splat_d(-side), f);
+  const GroupGeometry g = group_geometry<Kind>(surface, block, tip_mm);
+  const __m256d &px = g.px, &py = g.py, &pz = g.pz, &ox = g.ox, &oy = g.oy, &r = g.r, &depth = g.depth,
+                &curvature = g.curvature, &escape_radial = g.escape_radial, &escape_axial = g.escape_axial;
   // Radially out along (x, y) / r, or along +y on the axis.
   const __m256d off_axis = _mm256_cmp_pd(r, splat_d(1e-12), _CMP_GT_OQ);
   const __m256d radial_x = _mm256_and_pd(off_axis, _mm256_div_pd(ox, r));
