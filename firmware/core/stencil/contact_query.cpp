@@ -59,8 +59,8 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // region or just straddles its boundary (no walk of the tool tree per point), from the two sides'
 // regions when it straddles a partition plane, point by point through the tool tree when it
 // straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it or
-// outside), or split between two at a plane, goes loaded to visit_region_leaf(cover, leaf), which
-// settles its lanes itself (the query computes its force in the same pass) and answers a
+// outside), or split between two at a plane, goes bound (bind_leaf) to visit_region_leaf(cover,
+// leaf), which loads and settles its lanes itself (the query computes its force in the same pass) and answers a
 // LeafVisit; a mixed one goes settled to visit_leaf. For any other axis each point goes through classify_at_pose and
 // visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
 // block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
@@ -85,6 +85,7 @@ enum class LeafVisit : std::uint8_t {
 template <typename VisitLeaf>
 LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
                              LeafContacts& leaf, VisitLeaf& visit_leaf) {
+  load_lanes(leaf);
   const bool finite = cover.cover == geometry::BoxCover::SplitAtZ
                           ? split_leaf_contacts(tool, cover, leaf)
                           : region_leaf_contacts(tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, leaf);
@@ -156,13 +157,16 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   std::size_t size = 0;
   stack[size++] = {0, geometry::BoxCover::Mixed, 0};
   LeafContacts leaf;
+  // The node's cover, one object for the walk: a node settled by its ancestor sets only the fields
+  // a Region or RegionOrOutside cover has (the split's fields are read only when classify sets them).
+  geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
   // A deep leaf: settled by visit_deep_leaf from its block, or where that cannot, by its points.
   const auto visit_deep = [&](const geometry::BoxClassification& deep_cover, const tables::LeafBlock& block) {
     const LeafVisit visit = visit_deep_leaf(deep_cover, block);
     if (visit != LeafVisit::LoadPoints) {
       return visit;
     }
-    load_leaf(part, block, pose.tip_mm, leaf);
+    bind_leaf(part, block, pose.tip_mm, leaf);
     return visit_region_leaf(deep_cover, leaf);
   };
   while (size > 0) {
@@ -178,7 +182,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
     const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
     const bool settled = pending.settled != geometry::BoxCover::Mixed;
-    geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
+    cover.cover = geometry::BoxCover::Mixed;
     double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
     if (settled) {
       const geometry::DepthRange range =
@@ -186,7 +190,9 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       if (shallower_than_penetration(range.deepest_mm)) {
         continue;
       }
-      cover = {pending.settled, pending.region, range.deepest_mm, 0.0, {}, {}};
+      cover.cover = pending.settled;
+      cover.region = pending.region;
+      cover.deepest_bound_mm = range.deepest_mm;
       shallowest_mm = range.shallowest_mm;
     } else if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
@@ -220,7 +226,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           }
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
-        load_leaf(part, block, pose.tip_mm, leaf);
+        bind_leaf(part, block, pose.tip_mm, leaf);
         if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
             cover.cover == geometry::BoxCover::SplitAtZ) {
           const LeafVisit visit = visit_region_leaf(cover, leaf);
@@ -229,6 +235,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           }
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
+        load_lanes(leaf);
         if (!mixed_leaf_contacts(tool, leaf)) {
           return Walk::BadTree;
         }

@@ -100,6 +100,27 @@ LaneMask pack(const LaneFlags& flags) {
 #endif
 }
 
+#if defined(__AVX2__)
+// Lanes base..base+7 of the leaf's offsets from the tip, from its block: (p - high) - low, the
+// tip's parts splatted once per leaf.
+struct PointLanes {
+  __m256 x, y, z;
+};
+struct TipLanes {
+  __m256 high_x, high_y, high_z, low_x, low_y, low_z;
+};
+[[gnu::always_inline]] inline TipLanes tip_lanes(const LeafContacts& leaf) {
+  return {_mm256_set1_ps(leaf.tip_high[0]), _mm256_set1_ps(leaf.tip_high[1]), _mm256_set1_ps(leaf.tip_high[2]),
+          _mm256_set1_ps(leaf.tip_low[0]),  _mm256_set1_ps(leaf.tip_low[1]),  _mm256_set1_ps(leaf.tip_low[2])};
+}
+[[gnu::always_inline]] inline PointLanes point_lanes(const LeafContacts& leaf, const TipLanes& tip, std::uint32_t base) {
+  const tables::LeafBlock& block = *leaf.normals;
+  return {_mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.x_mm + base), tip.high_x), tip.low_x),
+          _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.y_mm + base), tip.high_y), tip.low_y),
+          _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.z_mm + base), tip.high_z), tip.low_z)};
+}
+#endif
+
 LaneMask lanes_below(std::uint32_t count) { return count >= kLanes ? ~LaneMask{0} : (LaneMask{1} << count) - 1U; }
 
 // How many points group `group` of the block has (0 past its points).
@@ -296,58 +317,59 @@ void summarise(float band, ExactDepth&& exact, LeafContacts& leaf) {
 
 }  // namespace
 
-void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
+void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf) {
   leaf.first = block.first_point;
   leaf.count = block.point_count;
   leaf.points = &part.points[block.first_point];
   leaf.tip_mm = tip_mm;
+  leaf.normals = &block;
   // The tip as a float and the float of what that leaves out: (p - high) - low is the offset to
   // within a rounding of its own size, however far the part is from the origin. The split is
   // Veltkamp's (tip = head + exactly the rest, head with a float's 24 bits): the plain
   // tip - double(float(tip)) is folded to 0 by GCC 12's vectorizer (x and y lost their rest;
   // LeafContacts.AnOffsetFromATipThatIsNotAFloatIsRightToARoundingOfItsOwnSize).
   constexpr double kVeltkamp = 536870913.0;  // 2^29 + 1: splits a double's 53 bits into 24 and 29
-  std::array<double, 3> head{};
-  for (Eigen::Index axis = 0; axis < 3; ++axis) {
-    const double scaled = kVeltkamp * tip_mm[axis];
-    head[static_cast<std::size_t>(axis)] = scaled - (scaled - tip_mm[axis]);
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    const double value = tip_mm[static_cast<Eigen::Index>(axis)];
+    const double scaled = kVeltkamp * value;
+    const double head = scaled - (scaled - value);
+    leaf.tip_high[axis] = static_cast<float>(head);
+    leaf.tip_low[axis] = static_cast<float>(value - head);
   }
-  const auto high_x = static_cast<float>(head[0]), high_y = static_cast<float>(head[1]), high_z = static_cast<float>(head[2]);
-  const auto low_x = static_cast<float>(tip_mm.x() - head[0]), low_y = static_cast<float>(tip_mm.y() - head[1]),
-             low_z = static_cast<float>(tip_mm.z() - head[2]);
+  // Every point within the block's sphere: |p - tip|_1 <= |centre - tip|_1 + sqrt(3) radius, and a
+  // lane's float offset within a rounding of the point's (the loader checked the sphere; a sphere
+  // that is not finite makes every lane's depth be settled in double precision).
+  const double bound = std::abs(double{block.centre_mm[0]} - tip_mm.x()) + std::abs(double{block.centre_mm[1]} - tip_mm.y()) +
+                       std::abs(double{block.centre_mm[2]} - tip_mm.z()) + 1.7320508075688773 * double{block.radius_mm};
+  leaf.magnitude_mm = std::isfinite(bound) ? static_cast<float>(bound * (1.0 + 1e-6)) : std::numeric_limits<float>::infinity();
+}
+
+void load_lanes(LeafContacts& leaf) {
   // The block's lanes are the leaf's points, the last repeated past count: plain vector loads, and
   // the normals are read where they are.
-  leaf.normals = &block;
 #if defined(__AVX2__)
-  const __m256 high_xs = _mm256_set1_ps(high_x), high_ys = _mm256_set1_ps(high_y), high_zs = _mm256_set1_ps(high_z);
-  const __m256 low_xs = _mm256_set1_ps(low_x), low_ys = _mm256_set1_ps(low_y), low_zs = _mm256_set1_ps(low_z);
-  const __m256 no_sign = _mm256_castsi256_ps(_mm256_set1_epi32(0x7fffffff));
-  __m256 largest = _mm256_setzero_ps();
+  const TipLanes tip = tip_lanes(leaf);
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
-    const __m256 x = _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.x_mm + base), high_xs), low_xs);
-    const __m256 y = _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.y_mm + base), high_ys), low_ys);
-    const __m256 z = _mm256_sub_ps(_mm256_sub_ps(_mm256_loadu_ps(block.z_mm + base), high_zs), low_zs);
-    _mm256_storeu_ps(leaf.x.data() + base, x);
-    _mm256_storeu_ps(leaf.y.data() + base, y);
-    _mm256_storeu_ps(leaf.z.data() + base, z);
-    const __m256 size = _mm256_add_ps(_mm256_add_ps(_mm256_and_ps(x, no_sign), _mm256_and_ps(y, no_sign)),
-                                      _mm256_and_ps(z, no_sign));
-    largest = _mm256_max_ps(size, largest);  // sizes are finite and not negative: exact, in any order
+    const PointLanes p = point_lanes(leaf, tip, base);
+    _mm256_storeu_ps(leaf.x.data() + base, p.x);
+    _mm256_storeu_ps(leaf.y.data() + base, p.y);
+    _mm256_storeu_ps(leaf.z.data() + base, p.z);
   }
-  const __m128 q = _mm_max_ps(_mm256_castps256_ps128(largest), _mm256_extractf128_ps(largest, 1));
-  const __m128 r = _mm_max_ps(q, _mm_movehl_ps(q, q));
-  leaf.magnitude_mm = _mm_cvtss_f32(_mm_max_ss(r, _mm_shuffle_ps(r, r, 1)));
 #else
-  LeafLanes size;
+  const tables::LeafBlock& block = *leaf.normals;
   for (std::uint32_t lane = 0; lane < kLanes; ++lane) {
-    leaf.x[lane] = (block.x_mm[lane] - high_x) - low_x;
-    leaf.y[lane] = (block.y_mm[lane] - high_y) - low_y;
-    leaf.z[lane] = (block.z_mm[lane] - high_z) - low_z;
-    size[lane] = std::abs(leaf.x[lane]) + std::abs(leaf.y[lane]) + std::abs(leaf.z[lane]);
+    leaf.x[lane] = (block.x_mm[lane] - leaf.tip_high[0]) - leaf.tip_low[0];
+    leaf.y[lane] = (block.y_mm[lane] - leaf.tip_high[1]) - leaf.tip_low[1];
+    leaf.z[lane] = (block.z_mm[lane] - leaf.tip_high[2]) - leaf.tip_low[2];
   }
-  leaf.magnitude_mm = lane_max(size);
 #endif
+}
+
+void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
+               LeafContacts& leaf) {
+  bind_leaf(part, block, tip_mm, leaf);
+  load_lanes(leaf);
 }
 
 bool region_leaf_contacts(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside, LeafContacts& leaf) {
@@ -736,14 +758,14 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
   // A group that cannot penetrate adds nothing: its lanes' depths are 0 either way (within the
   // band of the surface they would be settled in double precision, below it), so their forces.
   const unsigned shallow = shallow_groups<Kind>(surface, leaf);
+  const TipLanes tip = tip_lanes(leaf);
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
     if (((shallow >> (base / tables::kLeafGroupPoints)) & 1U) != 0) {
       _mm256_store_ps(depths.data() + base, _mm256_setzero_ps());
       continue;
     }
-    const __m256 x = _mm256_load_ps(leaf.x.data() + base);
-    const __m256 y = _mm256_load_ps(leaf.y.data() + base);
-    const __m256 z = _mm256_load_ps(leaf.z.data() + base);
+    const PointLanes p = point_lanes(leaf, tip, base);  // the lanes load_lanes would store, not stored
+    const __m256 x = p.x, y = p.y, z = p.z;
     const SurfaceLanes s = surface_lanes<Kind>(c, x, y, z);
     const __m256 d = _mm256_and_ps(below_count(leaf, base),
                                    region_depths(verdicts, leaf, base, s, valid, check, penetrating, depths));
@@ -827,10 +849,10 @@ bool split_force_lanes(const geometry::ImplicitSurface* below_surface, const geo
   alignas(32) LeafLanes depths;
   LaneForces forces(k_world, centre_height_mm);
   LaneMask is_below = 0;
+  const TipLanes tip = tip_lanes(leaf);
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
-    const __m256 x = _mm256_load_ps(leaf.x.data() + base);
-    const __m256 y = _mm256_load_ps(leaf.y.data() + base);
-    const __m256 z = _mm256_load_ps(leaf.z.data() + base);
+    const PointLanes p = point_lanes(leaf, tip, base);
+    const __m256 x = p.x, y = p.y, z = p.z;
     const __m256 point_z = _mm256_loadu_ps(leaf.normals->z_mm + base);
     const auto chunk = static_cast<std::uint32_t>(below_split(_mm256_castps256_ps128(point_z)) |
                                                   (below_split(_mm256_extractf128_ps(point_z, 1)) << 4));
@@ -890,6 +912,7 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
   // The rig's baseline build (x86-64-v2): the two steps on the walk's own leaf, as before the
   // fused pass (its deepest lane is searched either way; the answer is the same).
   static_cast<void>(surface);
+  load_lanes(leaf);
   if (!region_leaf_contacts(tool, region, or_outside, leaf)) {
     return false;
   }
@@ -915,6 +938,7 @@ bool split_leaf_force(const geometry::ToolBsp& tool, const geometry::BoxClassifi
   }
   return split_force_lanes(below, above, cover.split_z_mm, find_deepest, k_world, centre_height_mm, leaf, out);
 #else
+  load_lanes(leaf);
   if (!split_leaf_contacts(tool, cover, leaf)) {
     return false;
   }

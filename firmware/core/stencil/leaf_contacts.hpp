@@ -37,7 +37,9 @@ struct LeafContacts {
   std::uint32_t count;                // its points (1 to kMaxLeafPoints); lanes past count repeat the last point
   const tables::PackedPoint* points;  // the leaf's points in the tables, for the double-precision checks
   Eigen::Vector3d tip_mm;             // the tool's tip the offsets are taken from
-  float magnitude_mm;                 // no lane's |x| + |y| + |z| is larger
+  float tip_high[3];                  // the tip split for float offsets: (p - high) - low (see bind_leaf)
+  float tip_low[3];
+  float magnitude_mm;                 // no lane's |x| + |y| + |z| is larger (a bound from the block's sphere)
   alignas(32) LeafLanes x;            // offset of each point from the tip, world mm
   alignas(32) LeafLanes y;
   alignas(32) LeafLanes z;
@@ -54,9 +56,19 @@ struct LeafContacts {
   std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
 };
 
-// Loads the leaf's points (as offsets from tip_mm) into the lanes from its packed block, and keeps
-// the block for its normals (it must outlive the leaf's use). The block's count must be 1 to
-// kMaxLeafPoints and its run inside the tables (the loader checks it, the walk again).
+// Binds the leaf to its packed block and the tip: its run of points, the block for its points and
+// normals (it must outlive the leaf's use) and the bound of its offsets from its sphere, with no
+// lane loaded: region_leaf_force and split_leaf_force compute their lanes from the block as they
+// go. The block's count must be 1 to kMaxLeafPoints and its run inside the tables (the loader
+// checks it, the walk again).
+void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
+               LeafContacts& leaf);
+
+// Loads a bound leaf's points into the lanes x, y, z, as offsets from its tip: what every other
+// function of a leaf reads.
+void load_lanes(LeafContacts& leaf);
+
+// bind_leaf, then load_lanes.
 void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf);
 
@@ -86,8 +98,8 @@ struct LeafForceSums {
 };
 [[nodiscard]] LeafForceSums leaf_forces(const LeafContacts& leaf, double k_world, double centre_height_mm);
 
-// region_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (loaded by
-// load_leaf) lies in region `region` of the upright tool, or in it or outside (`or_outside`). The
+// region_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (bound by
+// bind_leaf, its lanes computed here as load_lanes would) lies in region `region` of the upright tool, or in it or outside (`or_outside`). The
 // same numbers, bit for bit, with nothing stored between the steps (with AVX2; without it, the two
 // steps themselves, the leaf settled in place). The deepest lane is searched only when
 // `find_deepest` (the caller knows no lane can beat what it has otherwise); max_depth_mm is 0 when
@@ -102,8 +114,8 @@ struct RegionLeafForce {
                                      bool find_deepest, double k_world, double centre_height_mm,
                                      LeafContacts& leaf, RegionLeafForce& out);
 
-// split_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (loaded by
-// load_leaf) straddles the partition plane of `cover` (SplitAtZ), each lane settled by its own
+// split_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (bound by
+// bind_leaf) straddles the partition plane of `cover` (SplitAtZ), each lane settled by its own
 // side's region. The same numbers, bit for bit, as the two steps, as region_leaf_force gives.
 [[nodiscard]] bool split_leaf_force(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
                                     bool find_deepest, double k_world, double centre_height_mm, LeafContacts& leaf,
