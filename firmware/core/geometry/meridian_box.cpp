@@ -7,46 +7,12 @@
 namespace stencil::geometry {
 namespace {
 
-struct Range {
-  double low;
-  double high;
-};
+using meridian_box_detail::Range;
+using meridian_box_detail::function_range;
+using meridian_box_detail::interior_range;
 
 // Invalid: a NaN in the tree's numbers, which classify_meridian reports as a fault per point.
 enum class Answer : std::uint8_t { True, False, Unknown, Invalid };
-
-// The range of the surface's natural function over the box. For a plane or a cylinder f is
-// monotonic in z or r; for a sphere or torus it is a distance from a centre, least at the box point
-// nearest the centre (the centre clamped into the box) and greatest at a corner.
-Range function_range(const ImplicitSurface& surface, const MeridianBox& box) {
-  switch (surface.kind) {
-    case SurfaceKind::PlaneZ:
-    case SurfaceKind::Cylinder:
-      return {surface_function(surface, {box.r_low_mm, box.z_low_mm}),
-              surface_function(surface, {box.r_high_mm, box.z_high_mm})};
-    case SurfaceKind::Sphere:
-    case SurfaceKind::Torus: {
-      const double centre_r = surface.kind == SurfaceKind::Torus ? surface.center_r_mm : 0.0;
-      const double near_r = std::min(std::max(centre_r, box.r_low_mm), box.r_high_mm);
-      const double near_z = std::min(std::max(surface.center_z_mm, box.z_low_mm), box.z_high_mm);
-      // The farthest corner pairs the larger squared offset in r with the larger one in z (the
-      // sum separates, and rounded addition and sqrt are monotonic): every corner's value, one sqrt.
-      const double dr_low = box.r_low_mm - centre_r, dr_high = box.r_high_mm - centre_r;
-      const double dz_low = box.z_low_mm - surface.center_z_mm, dz_high = box.z_high_mm - surface.center_z_mm;
-      const double far = std::sqrt(std::max(dr_low * dr_low, dr_high * dr_high) +
-                                   std::max(dz_low * dz_low, dz_high * dz_high)) -
-                         surface.radius_mm;
-      return {surface_function(surface, {near_r, near_z}), far};
-    }
-  }
-  return {std::nan(""), std::nan("")};
-}
-
-Range interior_range(const ImplicitSurface& surface, const MeridianBox& box) {
-  const Range f = function_range(surface, box);
-  // interior_distance is -f on a Below surface and f on an Above one; negation is exact.
-  return surface.solid_side == SolidSide::Below ? Range{-f.high, -f.low} : f;
-}
 
 bool is_nan(const Range& range) { return std::isnan(range.low) || std::isnan(range.high); }
 
@@ -193,27 +159,6 @@ BoxClassification classify_meridian_box(const ToolBsp& tool, const MeridianBox& 
 
 double region_deepest_bound(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box) {
   return interior_range(tool.surfaces[tool.regions[region].surface], box).high;
-}
-
-DepthRange region_depth_range(const ToolBsp& tool, std::uint8_t region, const MeridianBox& box) {
-  const Range range = interior_range(tool.surfaces[tool.regions[region].surface], box);
-  return {range.low, range.high};
-}
-
-MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
-                                 const Eigen::Vector3d& high) {
-  // Subtraction, squaring, addition and sqrt are each monotonic, so the nearest and farthest
-  // points of the box's footprint bound every point's r as the query rounds it.
-  const double x_low = low.x() - tip_mm.x();
-  const double x_high = high.x() - tip_mm.x();
-  const double y_low = low.y() - tip_mm.y();
-  const double y_high = high.y() - tip_mm.y();
-  const double near_x = std::min(std::max(0.0, x_low), x_high);
-  const double near_y = std::min(std::max(0.0, y_low), y_high);
-  const double far_x = std::max(x_low * x_low, x_high * x_high);
-  const double far_y = std::max(y_low * y_low, y_high * y_high);
-  return {std::sqrt(near_x * near_x + near_y * near_y), std::sqrt(far_x + far_y), low.z() - tip_mm.z(),
-          high.z() - tip_mm.z()};
 }
 
 }  // namespace stencil::geometry

@@ -157,6 +157,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   std::size_t size = 0;
   stack[size++] = {0, geometry::BoxCover::Mixed, 0};
   LeafContacts leaf;
+  const LeafTip tip = leaf_tip(pose.tip_mm);
   // The node's cover, one object for the walk: a node settled by its ancestor sets only the fields
   // a Region or RegionOrOutside cover has (the split's fields are read only when classify sets them).
   geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
@@ -166,7 +167,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     if (visit != LeafVisit::LoadPoints) {
       return visit;
     }
-    bind_leaf(part, block, pose.tip_mm, leaf);
+    bind_leaf(part, block, tip, leaf);
     return visit_region_leaf(deep_cover, leaf);
   };
   while (size > 0) {
@@ -226,7 +227,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           }
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
-        bind_leaf(part, block, pose.tip_mm, leaf);
+        bind_leaf(part, block, tip, leaf);
         if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
             cover.cover == geometry::BoxCover::SplitAtZ) {
           const LeafVisit visit = visit_region_leaf(cover, leaf);

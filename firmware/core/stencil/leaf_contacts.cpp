@@ -317,13 +317,8 @@ void summarise(float band, ExactDepth&& exact, LeafContacts& leaf) {
 
 }  // namespace
 
-void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
-               LeafContacts& leaf) {
-  leaf.first = block.first_point;
-  leaf.count = block.point_count;
-  leaf.points = &part.points[block.first_point];
-  leaf.tip_mm = tip_mm;
-  leaf.normals = &block;
+LeafTip leaf_tip(const Eigen::Vector3d& tip_mm) {
+  LeafTip tip{tip_mm, {}, {}};
   // The tip as a float and the float of what that leaves out: (p - high) - low is the offset to
   // within a rounding of its own size, however far the part is from the origin. The split is
   // Veltkamp's (tip = head + exactly the rest, head with a float's 24 bits): the plain
@@ -334,9 +329,23 @@ void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, c
     const double value = tip_mm[static_cast<Eigen::Index>(axis)];
     const double scaled = kVeltkamp * value;
     const double head = scaled - (scaled - value);
-    leaf.tip_high[axis] = static_cast<float>(head);
-    leaf.tip_low[axis] = static_cast<float>(value - head);
+    tip.high[axis] = static_cast<float>(head);
+    tip.low[axis] = static_cast<float>(value - head);
   }
+  return tip;
+}
+
+void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const LeafTip& tip, LeafContacts& leaf) {
+  leaf.first = block.first_point;
+  leaf.count = block.point_count;
+  leaf.points = &part.points[block.first_point];
+  leaf.normals = &block;
+  leaf.tip_mm = tip.mm;
+  for (std::size_t axis = 0; axis < 3; ++axis) {
+    leaf.tip_high[axis] = tip.high[axis];
+    leaf.tip_low[axis] = tip.low[axis];
+  }
+  const Eigen::Vector3d& tip_mm = tip.mm;
   // Every point within the block's sphere: |p - tip|_1 <= |centre - tip|_1 + sqrt(3) radius, and a
   // lane's float offset within a rounding of the point's (the loader checked the sphere; a sphere
   // that is not finite makes every lane's depth be settled in double precision).
@@ -368,7 +377,7 @@ void load_lanes(LeafContacts& leaf) {
 
 void load_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
                LeafContacts& leaf) {
-  bind_leaf(part, block, tip_mm, leaf);
+  bind_leaf(part, block, leaf_tip(tip_mm), leaf);
   load_lanes(leaf);
 }
 
@@ -636,7 +645,7 @@ void find_deepest_lane(const LeafLanes& depths, float band, LaneMask penetrating
 // One region's verdicts on eight lanes (surface_contacts' second loop): the depth where it
 // penetrates beyond the tolerance, else 0; the lanes in `check_lanes` whose float depth is within
 // the band settled again in double precision (`depths` is scratch for them). Adds the lanes'
-// function and escape to `check` and sets their bits in `penetrating`.
+// function to `check` and sets their bits in `penetrating`.
 struct RegionVerdicts {
   const geometry::ImplicitSurface* surface;
   __m256 minus_sign, tolerance, band, no_sign;
@@ -646,7 +655,9 @@ struct RegionVerdicts {
   const __m256 depth = _mm256_mul_ps(v.minus_sign, s.f);
   const __m256 deeper = _mm256_cmp_ps(depth, v.tolerance, _CMP_GT_OQ);
   __m256 d = _mm256_and_ps(deeper, depth);
-  check = _mm256_add_ps(check, _mm256_add_ps(_mm256_add_ps(_mm256_add_ps(s.f, s.ex), s.ey), s.ez));
+  // The function alone tells a lane that is not finite: where it is finite so are the offsets
+  // (it grows with them) and so the escape direction (a division by at least 1e-12).
+  check = _mm256_add_ps(check, s.f);
   penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
   const LaneMask uncertain =
       (static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(depth, v.no_sign), v.band, _CMP_LE_OQ)))
@@ -759,6 +770,7 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
   // band of the surface they would be settled in double precision, below it), so their forces.
   const unsigned shallow = shallow_groups<Kind>(surface, leaf);
   const TipLanes tip = tip_lanes(leaf);
+  const bool full = leaf.count >= kLanes;  // no lane past the count to clear
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
     if (((shallow >> (base / tables::kLeafGroupPoints)) & 1U) != 0) {
       _mm256_store_ps(depths.data() + base, _mm256_setzero_ps());
@@ -767,8 +779,8 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
     const PointLanes p = point_lanes(leaf, tip, base);  // the lanes load_lanes would store, not stored
     const __m256 x = p.x, y = p.y, z = p.z;
     const SurfaceLanes s = surface_lanes<Kind>(c, x, y, z);
-    const __m256 d = _mm256_and_ps(below_count(leaf, base),
-                                   region_depths(verdicts, leaf, base, s, valid, check, penetrating, depths));
+    const __m256 raw = region_depths(verdicts, leaf, base, s, valid, check, penetrating, depths);
+    const __m256 d = full ? raw : _mm256_and_ps(below_count(leaf, base), raw);
     _mm256_store_ps(depths.data() + base, d);
     forces.add(leaf, base, x, y, z, d, s);
   }

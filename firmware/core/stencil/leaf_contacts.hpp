@@ -56,13 +56,21 @@ struct LeafContacts {
   std::uint32_t deepest_lane; // the first lane at max_depth_mm (valid when penetrating > 0)
 };
 
+// The tool's tip, and split for the lanes' offsets: (p - high) - low is p's offset to within a
+// rounding of its own size, however far the part is from the origin (once per pose).
+struct LeafTip {
+  Eigen::Vector3d mm;
+  float high[3];
+  float low[3];
+};
+[[nodiscard]] LeafTip leaf_tip(const Eigen::Vector3d& tip_mm);
+
 // Binds the leaf to its packed block and the tip: its run of points, the block for its points and
 // normals (it must outlive the leaf's use) and the bound of its offsets from its sphere, with no
 // lane loaded: region_leaf_force and split_leaf_force compute their lanes from the block as they
 // go. The block's count must be 1 to kMaxLeafPoints and its run inside the tables (the loader
 // checks it, the walk again).
-void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const Eigen::Vector3d& tip_mm,
-               LeafContacts& leaf);
+void bind_leaf(const tables::PartTables& part, const tables::LeafBlock& block, const LeafTip& tip, LeafContacts& leaf);
 
 // Loads a bound leaf's points into the lanes x, y, z, as offsets from its tip: what every other
 // function of a leaf reads.
