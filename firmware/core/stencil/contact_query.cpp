@@ -157,7 +157,17 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   std::size_t size = 0;
   stack[size++] = {0, geometry::BoxCover::Mixed, 0};
   LeafContacts leaf;
-  const LeafTip tip = leaf_tip(pose.tip_mm);
+  // The tip split for the lanes, once a walk, and only when a leaf is met (a query in free space
+  // meets none).
+  LeafTip tip{};
+  bool tip_split = false;
+  const auto bind_to = [&](const tables::LeafBlock& block) {
+    if (!tip_split) {
+      tip = leaf_tip(pose.tip_mm);
+      tip_split = true;
+    }
+    bind_leaf(part, block, tip, leaf);
+  };
   // The node's cover, one object for the walk: a node settled by its ancestor sets only the fields
   // a Region or RegionOrOutside cover has (the split's fields are read only when classify sets them).
   geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
@@ -167,7 +177,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     if (visit != LeafVisit::LoadPoints) {
       return visit;
     }
-    bind_leaf(part, block, tip, leaf);
+    bind_to(block);
     return visit_region_leaf(deep_cover, leaf);
   };
   while (size > 0) {
@@ -227,7 +237,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
           }
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
-        bind_leaf(part, block, tip, leaf);
+        bind_to(block);
         if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
             cover.cover == geometry::BoxCover::SplitAtZ) {
           const LeafVisit visit = visit_region_leaf(cover, leaf);
