@@ -33,8 +33,8 @@ namespace {
 const Eigen::Vector3d kTip(123.4375, 78.90625, 10.0625);
 constexpr geometry::ToolSpec kBall{geometry::CutterKind::Ball, 3.0, 12.0, 0.0, 10.0, 20.0};
 
-// The block's sphere, moments and groups' moments, as the generator writes them (the loader
-// checks them): a sphere about the points' box's middle holding every point.
+// The block's sphere, moments and groups' moments: the moments as the generator writes them (the
+// loader checks them), the sphere about the points' box's middle holding every point.
 void with_moments(tables::LeafBlock& block) {
   Eigen::Vector3d low = Eigen::Vector3d::Constant(1e30), high = Eigen::Vector3d::Constant(-1e30);
   for (std::uint32_t lane = 0; lane < block.point_count; ++lane) {
@@ -364,6 +364,16 @@ TEST(LeafContacts, APointWhoseNormalIsItsEscapeDirectionGivesNoForce) {
 
 namespace {
 
+// The leaf as bind_leaf leaves it for the one-pass kernels: its lanes not loaded (NaN here, so a
+// kernel that read them would say so).
+LeafContacts without_lanes(const LeafContacts& loaded) {
+  LeafContacts bound = loaded;
+  bound.x.fill(std::numeric_limits<float>::quiet_NaN());
+  bound.y.fill(std::numeric_limits<float>::quiet_NaN());
+  bound.z.fill(std::numeric_limits<float>::quiet_NaN());
+  return bound;
+}
+
 // region_leaf_force against region_leaf_contacts then leaf_forces, on the leaf as loaded: the same
 // count, deepest lane and depth (when searched) and the same bits of force and torque.
 void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
@@ -374,7 +384,7 @@ void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometr
   const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
   CHECK(step_by_step.penetrating > 0);
   for (const bool find_deepest : {true, false}) {
-    LeafContacts leaf = loaded;
+    LeafContacts leaf = without_lanes(loaded);
     RegionLeafForce one_pass{};
     CHECK(region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
     LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
@@ -453,7 +463,7 @@ void check_one_pass_split_is_step_by_step(const geometry::ToolBsp& tool, const g
   const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
   CHECK(step_by_step.penetrating > 0);
   for (const bool find_deepest : {true, false}) {
-    LeafContacts leaf = loaded;
+    LeafContacts leaf = without_lanes(loaded);
     RegionLeafForce one_pass{};
     CHECK(split_leaf_force(tool, cover, find_deepest, 10.0, 7.5, leaf, one_pass));
     LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
@@ -523,6 +533,32 @@ TEST(LeafContacts, TheOnePassForceOfASplitLeafSettlesLanesOnEitherSurfaceInDoubl
   LeafContacts settled = leaf;
   CHECK(split_leaf_contacts(tool, cover, settled));
   check_against_the_tree(tool, points, settled);
+}
+
+TEST(LeafContacts, TheOnePassForceSkipsAGroupThatCannotPenetrateAndGivesTheStepsBits) {
+  // Across the bottom of the ball: the first two groups of lanes just inside it, the last two just
+  // below the tip, outside, each group's sphere short of the surface: skipped in the one pass.
+  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
+  for (std::uint32_t i = 0; i < points.count; ++i) {
+    const double t = static_cast<double>(i % tables::kLeafGroupPoints);
+    const bool inside = i / tables::kLeafGroupPoints < 2;
+    const Eigen::Vector3d p = kTip + Eigen::Vector3d(0.04 * std::sin(1.7 * t), 0.04 * std::cos(2.3 * t),
+                                                     (inside ? 0.03 : -0.08) + 0.01 * std::sin(0.9 * t));
+    points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+  }
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::RegionOrOutside);
+  const tables::LeafBlock& block = points.packed();
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[cover.region].surface];
+  for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
+    const Eigen::Vector3d centroid(block.group_centroid_mm[0][group], block.group_centroid_mm[1][group],
+                                   block.group_centroid_mm[2][group]);
+    const Eigen::Vector3d offset = centroid - kTip;
+    const double depth = geometry::interior_distance(surface, {std::hypot(offset.x(), offset.y()), offset.z()});
+    CHECK_EQUAL(group >= 2, depth + double{block.group_radius_mm[group]} < 0.0);  // the last two cannot penetrate
+  }
+  load_leaf(points.part, block, kTip, leaf);
+  check_one_pass_is_step_by_step(tool, cover, leaf);
 }
 
 TEST(LeafContacts, EveryLaneOfAFullLeafIsSettledAsTheTreeSettlesItsPoint) {

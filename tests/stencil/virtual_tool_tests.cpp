@@ -127,8 +127,9 @@ TEST(VirtualTool, PushedIntoAConcaveCornerItSlipsOutToBothFacesWithinTwoSlips) {
   // Resting against both faces: 1.5 mm (the ball's radius) from the wall, its tip on the floor.
   // Not moved along the slot, to well under a micrometre: leaves deep in the part are settled from
   // their moments or their groups' (the reaction's direction within half a degree of the points'
-  // own), which need not be symmetric about x = 25 (measured: 0.43 um).
-  DOUBLES_EQUAL(25.0, tool.tip_mm().x(), 1e-3);
+  // own), which need not be symmetric about x = 25 (measured: 0.43 um; allowed 5 um, half the
+  // other two checks').
+  DOUBLES_EQUAL(25.0, tool.tip_mm().x(), 5e-3);
   DOUBLES_EQUAL(11.0, tool.tip_mm().y(), 0.01);
   DOUBLES_EQUAL(3.0, tool.tip_mm().z(), 0.01);
 }

@@ -146,7 +146,7 @@ bool leaves_below(const tables::PartTables& part, std::uint32_t index, LeafRun& 
 // the tolerance has every point penetrating, all in that region: when only penetrating points are
 // wanted, the walk gives it to visit_deep_leaf(cover, block) unloaded, which settles it from the
 // block's own numbers (its count, sphere and moments) or answers LoadPoints, and the walk then
-// loads it and gives it to visit_region_leaf as any leaf in one region.
+// binds it and gives it to visit_region_leaf as any leaf in one region.
 template <typename VisitPoint, typename VisitLeaf, typename VisitRegionLeaf, typename VisitDeepLeaf>
 Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp& tool, const ToolPose& pose,
                          Wanted wanted, VisitPoint&& visit_point, VisitLeaf&& visit_leaf,

@@ -655,8 +655,9 @@ struct RegionVerdicts {
   const __m256 depth = _mm256_mul_ps(v.minus_sign, s.f);
   const __m256 deeper = _mm256_cmp_ps(depth, v.tolerance, _CMP_GT_OQ);
   __m256 d = _mm256_and_ps(deeper, depth);
-  // The function alone tells a lane that is not finite: where it is finite so are the offsets
-  // (it grows with them) and so the escape direction (a division by at least 1e-12).
+  // The function alone tells a lane that is not finite: the offsets are finite (finite points and
+  // tip, millimetres from each other), so the escape direction is (a division by at least 1e-12),
+  // and what can make a lane's numbers non-finite is the surface's, which reach its function.
   check = _mm256_add_ps(check, s.f);
   penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
   const LaneMask uncertain =
@@ -747,10 +748,15 @@ template <SurfaceKind Kind>
 [[gnu::always_inline]] inline unsigned shallow_groups(const geometry::ImplicitSurface& surface, const LeafContacts& leaf) {
   const tables::LeafBlock& block = *leaf.normals;
   const GroupGeometry g = group_geometry<Kind>(surface, block, leaf.tip_mm);
+  // A margin for the rounding of the one depth: about 1e-13 mm for a workspace a metre across.
   const __m256d deepest = _mm256_add_pd(_mm256_add_pd(g.depth, _mm256_cvtps_pd(_mm_loadu_ps(block.group_radius_mm))),
-                                        _mm256_set1_pd(1e-9));  // a margin for the rounding of the one depth
-  const unsigned shallow = static_cast<unsigned>(
-      _mm256_movemask_pd(_mm256_cmp_pd(deepest, _mm256_set1_pd(geometry::kSurfaceTolerance_mm), _CMP_LE_OQ)));
+                                        _mm256_set1_pd(1e-9));
+  // Not where the depth is not finite (a damaged surface): those lanes are computed, and their
+  // check fails.
+  const __m256d finite = _mm256_cmp_pd(_mm256_and_pd(deepest, _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff))),
+                                       _mm256_set1_pd(std::numeric_limits<double>::max()), _CMP_LE_OQ);
+  const unsigned shallow = static_cast<unsigned>(_mm256_movemask_pd(
+      _mm256_and_pd(finite, _mm256_cmp_pd(deepest, _mm256_set1_pd(geometry::kSurfaceTolerance_mm), _CMP_LE_OQ))));
   const unsigned groups = (leaf.count + tables::kLeafGroupPoints - 1) / tables::kLeafGroupPoints;
   return shallow | (0xFU & ~((1U << groups) - 1U));
 }
