@@ -51,16 +51,7 @@ void with_moments(tables::LeafBlock& block) {
     radius = std::max(radius, (Eigen::Vector3d(block.x_mm[lane], block.y_mm[lane], block.z_mm[lane]) - centre).norm());
   }
   block.radius_mm = static_cast<float>(radius * (1.0 + 1e-6));
-  const tables::LeafMoments moments = tables::leaf_moments(block);
-  std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
-  std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
-  for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
-    for (std::size_t axis = 0; axis < 3; ++axis) {
-      block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
-      block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
-    }
-    block.group_radius_mm[group] = moments.groups[group].radius_mm;
-  }
+  tables::store_moments(tables::leaf_moments(block), block);
 }
 
 // A leaf's points in a box around `centre` (offsets from the tip), spread over it by a fixed

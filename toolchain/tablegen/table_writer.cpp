@@ -77,16 +77,7 @@ std::vector<tables::LeafBlock> pack_leaves(TableContents& contents) {
       radius = std::max(radius, (Eigen::Vector3d(p.x_mm, p.y_mm, p.z_mm) - centre).norm());
     }
     block.radius_mm = std::nextafter(float_at_least(radius), std::numeric_limits<float>::infinity());
-    const tables::LeafMoments moments = tables::leaf_moments(block);
-    std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
-    std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
-    for (std::uint32_t group = 0; group < tables::kLeafGroups; ++group) {
-      for (std::size_t axis = 0; axis < 3; ++axis) {
-        block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
-        block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
-      }
-      block.group_radius_mm[group] = moments.groups[group].radius_mm;
-    }
+    tables::store_moments(tables::leaf_moments(block), block);
     leaves.push_back(block);
   }
   return leaves;

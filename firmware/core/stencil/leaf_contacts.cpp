@@ -910,6 +910,19 @@ bool split_force_lanes(const geometry::ImplicitSurface* below_surface, const geo
 
 }  // namespace
 
+#if !defined(__AVX2__)
+namespace {
+
+// The baseline build's answer from a leaf settled in two steps (its deepest lane is searched either
+// way; the answer is the same).
+RegionLeafForce settled_leaf_force(const LeafContacts& leaf, bool find_deepest, double k_world, double centre_height_mm) {
+  return {leaf.penetrating, find_deepest ? leaf.max_depth_mm : 0.0, find_deepest ? leaf.deepest_lane : 0U,
+          leaf_forces(leaf, k_world, centre_height_mm)};
+}
+
+}  // namespace
+#endif
+
 bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool or_outside, bool find_deepest,
                        double k_world, double centre_height_mm, LeafContacts& leaf, RegionLeafForce& out) {
   const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
@@ -928,16 +941,13 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
   return false;
 #else
   // The rig's baseline build (x86-64-v2): the two steps on the walk's own leaf, as before the
-  // fused pass (its deepest lane is searched either way; the answer is the same).
+  // fused pass.
   static_cast<void>(surface);
   load_lanes(leaf);
   if (!region_leaf_contacts(tool, region, or_outside, leaf)) {
     return false;
   }
-  out.penetrating = leaf.penetrating;
-  out.max_depth_mm = find_deepest ? leaf.max_depth_mm : 0.0;
-  out.deepest_lane = find_deepest ? leaf.deepest_lane : 0;
-  out.sums = leaf_forces(leaf, k_world, centre_height_mm);
+  out = settled_leaf_force(leaf, find_deepest, k_world, centre_height_mm);
   return true;
 #endif
 }
@@ -960,10 +970,7 @@ bool split_leaf_force(const geometry::ToolBsp& tool, const geometry::BoxClassifi
   if (!split_leaf_contacts(tool, cover, leaf)) {
     return false;
   }
-  out.penetrating = leaf.penetrating;
-  out.max_depth_mm = find_deepest ? leaf.max_depth_mm : 0.0;
-  out.deepest_lane = find_deepest ? leaf.deepest_lane : 0;
-  out.sums = leaf_forces(leaf, k_world, centre_height_mm);
+  out = settled_leaf_force(leaf, find_deepest, k_world, centre_height_mm);
   return true;
 #endif
 }

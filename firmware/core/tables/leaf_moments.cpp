@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 namespace stencil::tables {
@@ -61,6 +62,18 @@ LeafMoments leaf_moments(const LeafBlock& block) {
     }
   }
   return moments;
+}
+
+void store_moments(const LeafMoments& moments, LeafBlock& block) {
+  std::copy(std::begin(moments.centroid_mm), std::end(moments.centroid_mm), std::begin(block.centroid_mm));
+  std::copy(std::begin(moments.mean_normal), std::end(moments.mean_normal), std::begin(block.mean_normal));
+  for (std::uint32_t group = 0; group < kLeafGroups; ++group) {
+    for (std::size_t axis = 0; axis < 3; ++axis) {
+      block.group_centroid_mm[axis][group] = moments.groups[group].centroid_mm[axis];
+      block.group_mean_normal[axis][group] = moments.groups[group].mean_normal[axis];
+    }
+    block.group_radius_mm[group] = moments.groups[group].radius_mm;
+  }
 }
 
 }  // namespace stencil::tables

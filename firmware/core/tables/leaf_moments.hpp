@@ -20,4 +20,8 @@ struct LeafMoments {
 // as stored (the float), in double precision, rounded up to a float. Allocation-free.
 [[nodiscard]] LeafMoments leaf_moments(const LeafBlock& block);
 
+// Writes the moments into the block's fields (the groups' component by component), as the table
+// generator packs a block.
+void store_moments(const LeafMoments& moments, LeafBlock& block);
+
 }  // namespace stencil::tables
