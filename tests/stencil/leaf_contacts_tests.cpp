@@ -365,19 +365,24 @@ LeafContacts without_lanes(const LeafContacts& loaded) {
   return bound;
 }
 
-// region_leaf_force against region_leaf_contacts then leaf_forces, on the leaf as loaded: the same
-// count, deepest lane and depth (when searched) and the same bits of force and torque.
+// The one-pass force against the two steps, on the leaf as loaded: region_leaf_force against
+// region_leaf_contacts then leaf_forces, or for a leaf split at a plane split_leaf_force against
+// split_leaf_contacts then leaf_forces. The same count, deepest lane and depth (when searched) and
+// the same bits of force and torque.
 void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
                                     const LeafContacts& loaded) {
+  const bool split = cover.cover == geometry::BoxCover::SplitAtZ;
   const bool or_outside = cover.cover == geometry::BoxCover::RegionOrOutside;
   LeafContacts step_by_step = loaded;
-  CHECK(region_leaf_contacts(tool, cover.region, or_outside, step_by_step));
+  CHECK(split ? split_leaf_contacts(tool, cover, step_by_step)
+              : region_leaf_contacts(tool, cover.region, or_outside, step_by_step));
   const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
   CHECK(step_by_step.penetrating > 0);
   for (const bool find_deepest : {true, false}) {
     LeafContacts leaf = without_lanes(loaded);
     RegionLeafForce one_pass{};
-    CHECK(region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
+    CHECK(split ? split_leaf_force(tool, cover, find_deepest, 10.0, 7.5, leaf, one_pass)
+                : region_leaf_force(tool, cover.region, or_outside, find_deepest, 10.0, 7.5, leaf, one_pass));
     LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
     DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
     LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
@@ -415,57 +420,55 @@ TEST(LeafContacts, TheOnePassForceOfALeafInOneRegionIsTheStepByStepOneBitForBit)
   LONGS_EQUAL(0xF, kinds_seen);  // plane, cylinder, sphere and torus
 }
 
-TEST(LeafContacts, TheOnePassForceSettlesLanesOnTheSurfaceInDoublePrecisionAsTheStepsDo) {
-  // Points on the ball's surface, to a float's rounding: their float depths are within the band,
-  // so each is settled again in double precision, in the one pass as in the steps.
-  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
-  const Eigen::Vector3d centre(0.0, 0.0, 1.5);
+namespace {
+
+// Puts point i of the leaf at place(i), and counts the points within the lanes' band of the tool's
+// surface (touching, or less than 3e-6 mm from it) as the tree classifies them.
+template <typename Place>
+std::uint32_t place_points(const geometry::ToolBsp& tool, LeafPoints& points, Place&& place) {
   std::uint32_t on_the_surface = 0;
   for (std::uint32_t i = 0; i < points.count; ++i) {
-    const double t = static_cast<double>(i);
-    const double polar = 2.0 + 0.4 * std::sin(1.3 * t);  // below the equator, away from the tip
-    const double azimuth = 0.3 * std::cos(0.7 * t);
-    const Eigen::Vector3d p =
-        kTip + centre + 1.5 * Eigen::Vector3d(std::sin(polar) * std::cos(azimuth), std::sin(polar) * std::sin(azimuth),
-                                              std::cos(polar));
+    const Eigen::Vector3d p = place(i);
     points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
     const geometry::PointClassification c =
         geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(i));
     const double depth = c.contact == geometry::PointContact::Outside ? -1.0 : c.depth_mm;
     on_the_surface += std::abs(depth) < 3e-6 || c.contact == geometry::PointContact::Touching ? 1U : 0U;
   }
+  return on_the_surface;
+}
+
+// A leaf of points placed on the tool's surface (place_points): enough of them within the band,
+// its box settled as `expected`, the one pass giving the steps' bits, and the steps each point's
+// verdict from the tree.
+void check_surface_leaf(const geometry::ToolBsp& tool, const LeafPoints& points, std::uint32_t on_the_surface,
+                        geometry::BoxCover expected, LeafContacts& leaf) {
   CHECK_TEXT(on_the_surface > 8, "points within the lanes' band of the surface");
   const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
-  CHECK(cover.cover == geometry::BoxCover::RegionOrOutside);
+  CHECK(cover.cover == expected);
   load_leaf(points.part, points.packed(), kTip, leaf);
   check_one_pass_is_step_by_step(tool, cover, leaf);
   LeafContacts settled = leaf;
-  CHECK(region_leaf_contacts(tool, cover.region, true, settled));
+  CHECK(settle(tool, cover, settled));
   check_against_the_tree(tool, points, settled);
 }
 
-namespace {
-
-// split_leaf_force against split_leaf_contacts then leaf_forces, likewise.
-void check_one_pass_split_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
-                                          const LeafContacts& loaded) {
-  LeafContacts step_by_step = loaded;
-  CHECK(split_leaf_contacts(tool, cover, step_by_step));
-  const LeafForceSums sums = leaf_forces(step_by_step, 10.0, 7.5);
-  CHECK(step_by_step.penetrating > 0);
-  for (const bool find_deepest : {true, false}) {
-    LeafContacts leaf = without_lanes(loaded);
-    RegionLeafForce one_pass{};
-    CHECK(split_leaf_force(tool, cover, find_deepest, 10.0, 7.5, leaf, one_pass));
-    LONGS_EQUAL(step_by_step.penetrating, one_pass.penetrating);
-    DOUBLES_EQUAL(find_deepest ? step_by_step.max_depth_mm : 0.0, one_pass.max_depth_mm, 0.0);
-    LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
-    CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
-    CHECK(sums.torque == one_pass.sums.torque);
-  }
-}
-
 }  // namespace
+
+TEST(LeafContacts, TheOnePassForceSettlesLanesOnTheSurfaceInDoublePrecisionAsTheStepsDo) {
+  // Points on the ball's surface, to a float's rounding: their float depths are within the band,
+  // so each is settled again in double precision, in the one pass as in the steps.
+  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
+  const Eigen::Vector3d centre(0.0, 0.0, 1.5);
+  const std::uint32_t on_the_surface = place_points(tool, points, [&](std::uint32_t i) {
+    const double t = static_cast<double>(i);
+    const double polar = 2.0 + 0.4 * std::sin(1.3 * t);  // below the equator, away from the tip
+    const double azimuth = 0.3 * std::cos(0.7 * t);
+    return Eigen::Vector3d(kTip + centre + 1.5 * Eigen::Vector3d(std::sin(polar) * std::cos(azimuth),
+                                                                 std::sin(polar) * std::sin(azimuth), std::cos(polar)));
+  });
+  check_surface_leaf(tool, points, on_the_surface, geometry::BoxCover::RegionOrOutside, leaf);
+}
 
 TEST(LeafContacts, TheOnePassForceOfALeafSplitAtAPlaneIsTheStepByStepOneBitForBit) {
   // Leaves across the plane between the ball and the flutes: inside both, across both surfaces
@@ -492,7 +495,7 @@ TEST(LeafContacts, TheOnePassForceOfALeafSplitAtAPlaneIsTheStepByStepOneBitForBi
       straddling += cover.below.cover == geometry::BoxCover::RegionOrOutside ||
                             cover.above.cover == geometry::BoxCover::RegionOrOutside ? 1U : 0U;
       load_leaf(points.part, points.packed(), kTip, leaf);
-      check_one_pass_split_is_step_by_step(tool, cover, leaf);
+      check_one_pass_is_step_by_step(tool, cover, leaf);
     }
   }
   LONGS_EQUAL(8, splits);  // all but the leaf at the flutes' end, which lies in one region
@@ -504,26 +507,13 @@ TEST(LeafContacts, TheOnePassForceOfASplitLeafSettlesLanesOnEitherSurfaceInDoubl
   // Points on the ball's equator and the flutes' cylinder above it, to a float's rounding, every
   // fourth one deep inside: lanes within the band of each side's surface.
   LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
-  std::uint32_t on_the_surface = 0;
-  for (std::uint32_t i = 0; i < points.count; ++i) {
+  const std::uint32_t on_the_surface = place_points(tool, points, [](std::uint32_t i) {
     const double t = static_cast<double>(i);
     const double r = i % 4 == 0 ? 1.2 : 1.5;
     const double azimuth = 0.3 * std::cos(0.7 * t);
-    const Eigen::Vector3d p = kTip + Eigen::Vector3d(r * std::cos(azimuth), r * std::sin(azimuth), 1.5 + 0.2 * std::sin(1.3 * t));
-    points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
-    const geometry::PointClassification c =
-        geometry::classify_at_pose(tool, kTip, Eigen::Vector3d::UnitZ(), points.point(i));
-    const double depth = c.contact == geometry::PointContact::Outside ? -1.0 : c.depth_mm;
-    on_the_surface += std::abs(depth) < 3e-6 || c.contact == geometry::PointContact::Touching ? 1U : 0U;
-  }
-  CHECK_TEXT(on_the_surface > 8, "points within the lanes' band of the surface");
-  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
-  CHECK(cover.cover == geometry::BoxCover::SplitAtZ);
-  load_leaf(points.part, points.packed(), kTip, leaf);
-  check_one_pass_split_is_step_by_step(tool, cover, leaf);
-  LeafContacts settled = leaf;
-  CHECK(split_leaf_contacts(tool, cover, settled));
-  check_against_the_tree(tool, points, settled);
+    return Eigen::Vector3d(kTip + Eigen::Vector3d(r * std::cos(azimuth), r * std::sin(azimuth), 1.5 + 0.2 * std::sin(1.3 * t)));
+  });
+  check_surface_leaf(tool, points, on_the_surface, geometry::BoxCover::SplitAtZ, leaf);
 }
 
 TEST(LeafContacts, TheOnePassForceSkipsAGroupThatCannotPenetrateAndGivesTheStepsBits) {
