@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <utility>
 
 #include "firmware/core/geometry/meridian_box.hpp"
 #include "firmware/core/geometry/tool_bsp_builder.hpp"
@@ -264,4 +265,92 @@ TEST(MeridianBox, ABoxInsideASettledOneIsSettledInTheSameRegionWithTheSameBound)
     }
     CHECK_TEXT(inner_settled > 1000, sample.name);
   }
+}
+
+// The walk under a settled node asks UprightDepthSpan first and region_depth_range only when it
+// is unsure: every answer it gives must be the one region_depth_range's numbers give, and it must
+// be unsure only where it has to be, for every
+// region of every sample tool, with thresholds at the query's (half the tolerance and the
+// tolerance) and at a few tenths of a millimetre, where boxes cross them often.
+TEST(MeridianBox, TheDepthSpanWithoutASqrtAgreesWithTheDepthRangeAndLeavesOnlyWhatItMust) {
+  std::mt19937_64 random(31);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  const Eigen::Vector3d tip(20.0, -7.5, 3.25);
+  for (const auto& sample : kSampleTools) {
+    ToolBsp tool{};
+    CHECK(build_tool_bsp(sample.spec, tool).ok);
+    for (std::uint8_t region = 0; region < tool.region_count; ++region) {
+      const ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
+      for (const auto& [shallow, deep] : {std::pair{0.5 * kSurfaceTolerance_mm, kSurfaceTolerance_mm},
+                                          std::pair{0.1, 0.3}}) {
+        const UprightDepthSpan span(tool, region, tip, shallow, deep);
+        LONGS_EQUAL(region, span.region());
+        int answered = 0;
+        for (int i = 0; i < 3000; ++i) {
+          // A box near the surface's reach, 10 um to 1 mm across, around the axis or beside it.
+          const double reach = surface.kind == SurfaceKind::PlaneZ ? 1.0 : surface.radius_mm;
+          const Eigen::Vector3d corner(reach * (2.0 * unit(random) - 1.2), reach * (2.0 * unit(random) - 1.2),
+                                       tool.envelope.total_length_mm * (1.1 * unit(random) - 0.05));
+          const double size = std::pow(10.0, -2.0 + 2.0 * unit(random));
+          const Eigen::Vector3d low = tip + corner;
+          const Eigen::Vector3d high = low + size * Eigen::Vector3d(unit(random), unit(random), unit(random));
+          const DepthRange range = region_depth_range(tool, region, upright_meridian_box(tip, low, high));
+          switch (span(low, high)) {
+            case DepthSpan::Shallower:
+              CHECK_TEXT(range.deepest_mm < shallow, sample.name);
+              ++answered;
+              break;
+            case DepthSpan::Between:
+              CHECK_TEXT(range.deepest_mm >= shallow && range.shallowest_mm <= deep, sample.name);
+              ++answered;
+              break;
+            case DepthSpan::Unsure:
+              // Left to the sqrt: a torus, a side whose solid is outside it, a box wholly deeper
+              // than `deep` (the walk wants its numbers), or one within rounding of a threshold.
+              CHECK_TEXT(surface.kind == SurfaceKind::Torus || surface.solid_side != SolidSide::Below ||
+                             range.shallowest_mm > deep || std::abs(range.deepest_mm - shallow) < 1e-6 ||
+                             std::abs(range.shallowest_mm - deep) < 1e-6,
+                         sample.name);
+              break;
+          }
+        }
+        CHECK_TEXT(surface.kind == SurfaceKind::Torus ? answered == 0 : answered > 100, sample.name);
+      }
+    }
+  }
+}
+
+// Boxes whose nearest or farthest point lies within a few units of rounding of a threshold: the
+// span answers them as the sqrt does, or not at all.
+TEST(MeridianBox, TheDepthSpanLeavesABoxAtAThresholdToTheSqrt) {
+  ToolBsp tool{};
+  CHECK(build_tool_bsp(kSampleTools[2].spec, tool).ok);  // ball d3: the hemisphere's centre 1.5 above the tip
+  const Eigen::Vector3d tip(20.0, -7.5, 3.25);
+  int unsure = 0;
+  for (std::uint8_t region = 0; region < tool.region_count; ++region) {
+    const ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
+    if (surface.kind != SurfaceKind::Sphere) {
+      continue;
+    }
+    const double shallow = 0.5 * kSurfaceTolerance_mm;
+    const double deep = kSurfaceTolerance_mm;
+    const UprightDepthSpan span(tool, region, tip, shallow, deep);
+    // A point straight below the centre at the radius less `depth`: its depth is `depth`, give or take rounding.
+    for (const double depth : {shallow, deep}) {
+      for (int ulps = -4; ulps <= 4; ++ulps) {
+        const double z = tip.z() + surface.center_z_mm - (surface.radius_mm - depth) + ulps * 4e-16;
+        const Eigen::Vector3d low(tip.x(), tip.y(), z);
+        const Eigen::Vector3d high(tip.x() + 1e-3, tip.y() + 1e-3, z);
+        const DepthRange range = region_depth_range(tool, region, upright_meridian_box(tip, low, high));
+        const DepthSpan answer = span(low, high);
+        unsure += answer == DepthSpan::Unsure ? 1 : 0;
+        if (answer == DepthSpan::Shallower) {
+          CHECK(range.deepest_mm < shallow);
+        } else if (answer == DepthSpan::Between) {
+          CHECK(range.deepest_mm >= shallow && range.shallowest_mm <= deep);
+        }
+      }
+    }
+  }
+  CHECK(unsure >= 9);  // at least the nine boxes at the skipping threshold
 }

@@ -143,4 +143,99 @@ inline MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eig
           high.z() - tip_mm.z()};
 }
 
+
+// Between which depths a node's box lies, told without a sqrt where the rounding cannot matter: the
+// walk of the points' tree asks it of every node under a settled one, and most of them are told
+// apart here, without the two sqrts in a chain that region_depth_range takes for a ball or a side.
+enum class DepthSpan : std::uint8_t {
+  Shallower,  // region_depth_range(tool, region, upright_meridian_box(tip, low, high)) has deepest_mm < shallow_mm
+  Between,    // ... has deepest_mm >= shallow_mm and shallowest_mm <= deep_mm
+  Unsure,     // ask region_depth_range: too near either threshold, a torus, a solid above its surface,
+              // a threshold past half the radius, or numbers that are not finite
+};
+
+// For a plane, region_depth_range's own arithmetic (it needs no radius). For a ball centred on the
+// axis or a side, the squared distance from the centre (axis) of the box's nearest and farthest
+// points against the squared distance at which the depth R - d reaches each threshold, with a
+// relative margin of 1e-9: the sqrt-based depths round within a few units of 1e-16 of these, so
+// an answer given here is the one region_depth_range's numbers give. Set up once for a region and
+// a tip (the walk meets one region in most subtrees), then asked of many boxes.
+class UprightDepthSpan {
+ public:
+  UprightDepthSpan(const ToolBsp& tool, std::uint8_t region, const Eigen::Vector3d& tip_mm, double shallow_mm,
+                   double deep_mm)
+      : surface_(&tool.surfaces[tool.regions[region].surface]),
+        tip_mm_(tip_mm),
+        shallow_mm_(shallow_mm),
+        deep_mm_(deep_mm),
+        skip_above_(0.0),
+        skip_below_(0.0),
+        deep_above_(0.0),
+        kind_(Kind::Unsure),
+        region_(region) {
+    const double skip_reach = surface_->radius_mm - shallow_mm;  // nearer than this: deeper than shallow_mm
+    const double deep_reach = surface_->radius_mm - deep_mm;     // farther than this: not deeper than deep_mm
+    constexpr double kMargin = 1e-9;
+    if (surface_->kind == SurfaceKind::PlaneZ) {
+      kind_ = Kind::Plane;
+    } else if ((surface_->kind == SurfaceKind::Sphere || surface_->kind == SurfaceKind::Cylinder) &&
+               surface_->solid_side == SolidSide::Below && deep_reach > 0.5 * surface_->radius_mm &&
+               skip_reach > 0.5 * surface_->radius_mm) {
+      kind_ = surface_->kind == SurfaceKind::Sphere ? Kind::Ball : Kind::Side;
+      skip_above_ = skip_reach * skip_reach * (1.0 + kMargin);
+      skip_below_ = skip_reach * skip_reach * (1.0 - kMargin);
+      deep_above_ = deep_reach * deep_reach * (1.0 + kMargin);
+    }
+  }
+
+  std::uint8_t region() const { return region_; }
+
+  [[gnu::always_inline]] DepthSpan operator()(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const {
+    if (kind_ == Kind::Unsure) {
+      return DepthSpan::Unsure;
+    }
+    const double z_low = low.z() - tip_mm_.z();
+    const double z_high = high.z() - tip_mm_.z();
+    if (kind_ == Kind::Plane) {
+      const meridian_box_detail::Range range = meridian_box_detail::interior_range(*surface_, {0.0, 0.0, z_low, z_high});
+      if (range.high < shallow_mm_) {
+        return DepthSpan::Shallower;
+      }
+      return range.high >= shallow_mm_ && range.low <= deep_mm_ ? DepthSpan::Between : DepthSpan::Unsure;
+    }
+    const double x_low = low.x() - tip_mm_.x();
+    const double x_high = high.x() - tip_mm_.x();
+    const double y_low = low.y() - tip_mm_.y();
+    const double y_high = high.y() - tip_mm_.y();
+    const double near_x = std::min(std::max(0.0, x_low), x_high);
+    const double near_y = std::min(std::max(0.0, y_low), y_high);
+    double near_squared = near_x * near_x + near_y * near_y;
+    double far_squared = std::max(x_low * x_low, x_high * x_high) + std::max(y_low * y_low, y_high * y_high);
+    if (kind_ == Kind::Ball) {
+      const double centre_z = surface_->center_z_mm;
+      const double near_dz = std::min(std::max(centre_z, z_low), z_high) - centre_z;
+      const double dz_low = z_low - centre_z;
+      const double dz_high = z_high - centre_z;
+      near_squared += near_dz * near_dz;
+      far_squared += std::max(dz_low * dz_low, dz_high * dz_high);
+    }
+    if (near_squared > skip_above_) {
+      return DepthSpan::Shallower;
+    }
+    return near_squared < skip_below_ && far_squared > deep_above_ ? DepthSpan::Between : DepthSpan::Unsure;
+  }
+
+ private:
+  enum class Kind : std::uint8_t { Unsure, Plane, Ball, Side };
+  const ImplicitSurface* surface_;
+  Eigen::Vector3d tip_mm_;
+  double shallow_mm_;
+  double deep_mm_;
+  double skip_above_;  // squared distances, margins included
+  double skip_below_;
+  double deep_above_;
+  Kind kind_;
+  std::uint8_t region_;
+};
+
 }  // namespace stencil::geometry

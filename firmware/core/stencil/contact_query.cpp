@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Geometry>
 
@@ -180,6 +181,20 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     bind_to(block);
     return visit_region_leaf(deep_cover, leaf);
   };
+  // The depth span of settled nodes, set up for the region of the last one met.
+  std::optional<geometry::UprightDepthSpan> span_of;
+  // The node's two children, each settled as `child` says, the left one walked first. False when
+  // the tree is deeper than the loader allows: the tables were not loaded by it.
+  const auto push_children = [&](std::uint32_t index, const tables::BvhNode& node, Pending child) {
+    if (size + 2 > stack.size()) {
+      return false;
+    }
+    child.index = node.right_child;
+    stack[size++] = child;
+    child.index = index + 1;
+    stack[size++] = child;
+    return true;
+  };
   while (size > 0) {
     const Pending pending = stack[--size];
     const std::uint32_t index = pending.index;
@@ -196,6 +211,22 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     cover.cover = geometry::BoxCover::Mixed;
     double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
     if (settled) {
+      // Most nodes under a settled one are told shallow, or between the thresholds (a node to walk
+      // into), without region_depth_range's sqrts: the same answers (upright_depth_span).
+      if (!span_of || span_of->region() != pending.region) {
+        span_of.emplace(tool, pending.region, pose.tip_mm, 0.5 * geometry::kSurfaceTolerance_mm,
+                        geometry::kSurfaceTolerance_mm);
+      }
+      const geometry::DepthSpan span = (*span_of)(low, high);
+      if (span == geometry::DepthSpan::Shallower) {
+        continue;
+      }
+      if (span == geometry::DepthSpan::Between && node.point_count == 0) {
+        if (!push_children(index, node, pending)) {
+          return Walk::BadTree;
+        }
+        continue;
+      }
       const geometry::DepthRange range =
           geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
       if (shallower_than_penetration(range.deepest_mm)) {
@@ -301,13 +332,9 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       }
       continue;
     }
-    if (size + 2 > stack.size()) {
-      return Walk::BadTree;  // deeper than the loader allows: the tables were not loaded by it
+    if (!push_children(index, node, child)) {
+      return Walk::BadTree;
     }
-    child.index = node.right_child;
-    stack[size++] = child;
-    child.index = index + 1;
-    stack[size++] = child;
   }
   return Walk::Finished;
 }
