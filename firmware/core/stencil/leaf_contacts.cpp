@@ -541,41 +541,65 @@ void escape_lanes(__m256 r, __m256 radial, __m256 axial, __m256 x, __m256 y, Sur
 
 __m256 radius_lanes(__m256 x, __m256 y) { return _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y))); }
 
+// The surface's function of eight lanes, with what its escape direction is made from: the one
+// sqrt a depth needs, apart from the division the direction needs, so that a kernel can leave the
+// direction out where no lane penetrates.
+struct SurfaceFunction {
+  __m256 f, length, r, dr, dz;  // length: from the centre (sphere, torus); r: from the axis (cylinder, torus)
+};
+
 template <SurfaceKind Kind>
-SurfaceLanes surface_lanes(const SurfaceConstants& c, __m256 x, __m256 y, __m256 z) {
-  SurfaceLanes s{};
+[[gnu::always_inline]] inline SurfaceFunction surface_function_lanes(const SurfaceConstants& c, __m256 x, __m256 y, __m256 z) {
+  SurfaceFunction s{};
   if constexpr (Kind == SurfaceKind::PlaneZ) {
     s.f = _mm256_sub_ps(z, c.centre_z);
+  } else if constexpr (Kind == SurfaceKind::Cylinder) {
+    s.r = radius_lanes(x, y);
+    s.f = _mm256_sub_ps(s.r, c.radius);
+  } else if constexpr (Kind == SurfaceKind::Sphere) {
+    s.dz = _mm256_sub_ps(z, c.centre_z);
+    s.length = _mm256_sqrt_ps(
+        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(s.dz, s.dz)));
+    s.f = _mm256_sub_ps(s.length, c.radius);
+  } else {
+    s.r = radius_lanes(x, y);
+    s.dr = _mm256_sub_ps(s.r, c.centre_r);
+    s.dz = _mm256_sub_ps(z, c.centre_z);
+    s.length = _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(s.dr, s.dr), _mm256_mul_ps(s.dz, s.dz)));
+    s.f = _mm256_sub_ps(s.length, c.radius);
+  }
+  return s;
+}
+
+template <SurfaceKind Kind>
+[[gnu::always_inline]] inline SurfaceLanes escape_of(const SurfaceConstants& c, const SurfaceFunction& f, __m256 x, __m256 y) {
+  SurfaceLanes s{};
+  s.f = f.f;
+  if constexpr (Kind == SurfaceKind::PlaneZ) {
     s.ex = _mm256_setzero_ps();
     s.ey = _mm256_setzero_ps();
     s.ez = c.sign;
   } else if constexpr (Kind == SurfaceKind::Cylinder) {
-    const __m256 r = radius_lanes(x, y);
-    s.f = _mm256_sub_ps(r, c.radius);
-    escape_lanes(r, c.sign, _mm256_setzero_ps(), x, y, s);
+    escape_lanes(f.r, c.sign, _mm256_setzero_ps(), x, y, s);
   } else if constexpr (Kind == SurfaceKind::Sphere) {
-    const __m256 dz = _mm256_sub_ps(z, c.centre_z);
-    const __m256 length = _mm256_sqrt_ps(
-        _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(x, x), _mm256_mul_ps(y, y)), _mm256_mul_ps(dz, dz)));
-    s.f = _mm256_sub_ps(length, c.radius);
-    const __m256 degenerate = _mm256_cmp_ps(length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
-    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), length));
+    const __m256 degenerate = _mm256_cmp_ps(f.length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
+    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), f.length));
     s.ex = _mm256_blendv_ps(_mm256_mul_ps(x, inverse), _mm256_setzero_ps(), degenerate);
     s.ey = _mm256_blendv_ps(_mm256_mul_ps(y, inverse), splat(kInvSqrt2), degenerate);
-    s.ez = _mm256_blendv_ps(_mm256_mul_ps(dz, inverse), splat(-kInvSqrt2), degenerate);
+    s.ez = _mm256_blendv_ps(_mm256_mul_ps(f.dz, inverse), splat(-kInvSqrt2), degenerate);
   } else {
-    const __m256 r = radius_lanes(x, y);
-    const __m256 dr = _mm256_sub_ps(r, c.centre_r);
-    const __m256 dz = _mm256_sub_ps(z, c.centre_z);
-    const __m256 length = _mm256_sqrt_ps(_mm256_add_ps(_mm256_mul_ps(dr, dr), _mm256_mul_ps(dz, dz)));
-    s.f = _mm256_sub_ps(length, c.radius);
-    const __m256 degenerate = _mm256_cmp_ps(length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
-    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), length));
-    const __m256 radial = _mm256_blendv_ps(_mm256_mul_ps(dr, inverse), splat(kInvSqrt2), degenerate);
-    const __m256 axial = _mm256_blendv_ps(_mm256_mul_ps(dz, inverse), splat(-kInvSqrt2), degenerate);
-    escape_lanes(r, radial, axial, x, y, s);
+    const __m256 degenerate = _mm256_cmp_ps(f.length, splat(kDegenerateDistance_mm), _CMP_NGE_UQ);
+    const __m256 inverse = _mm256_div_ps(c.sign, _mm256_max_ps(splat(kDegenerateDistance_mm), f.length));
+    const __m256 radial = _mm256_blendv_ps(_mm256_mul_ps(f.dr, inverse), splat(kInvSqrt2), degenerate);
+    const __m256 axial = _mm256_blendv_ps(_mm256_mul_ps(f.dz, inverse), splat(-kInvSqrt2), degenerate);
+    escape_lanes(f.r, radial, axial, x, y, s);
   }
   return s;
+}
+
+template <SurfaceKind Kind>
+SurfaceLanes surface_lanes(const SurfaceConstants& c, __m256 x, __m256 y, __m256 z) {
+  return escape_of<Kind>(c, surface_function_lanes<Kind>(c, x, y, z), x, y);
 }
 
 // leaf_forces' arithmetic over eight lanes at a time, summed into eight partials per component.
@@ -650,15 +674,15 @@ struct RegionVerdicts {
   const geometry::ImplicitSurface* surface;
   __m256 minus_sign, tolerance, band, no_sign;
 };
-[[gnu::always_inline]] inline __m256 region_depths(const RegionVerdicts& v, const LeafContacts& leaf, std::uint32_t base, const SurfaceLanes& s,
+[[gnu::always_inline]] inline __m256 region_depths(const RegionVerdicts& v, const LeafContacts& leaf, std::uint32_t base, __m256 f,
                      LaneMask check_lanes, __m256& check, LaneMask& penetrating, LeafLanes& depths) {
-  const __m256 depth = _mm256_mul_ps(v.minus_sign, s.f);
+  const __m256 depth = _mm256_mul_ps(v.minus_sign, f);
   const __m256 deeper = _mm256_cmp_ps(depth, v.tolerance, _CMP_GT_OQ);
   __m256 d = _mm256_and_ps(deeper, depth);
   // The function alone tells a lane that is not finite: the offsets are finite (finite points and
   // tip, millimetres from each other), so the escape direction is (a division by at least 1e-12),
   // and what can make a lane's numbers non-finite is the surface's, which reach its function.
-  check = _mm256_add_ps(check, s.f);
+  check = _mm256_add_ps(check, f);
   penetrating |= static_cast<LaneMask>(_mm256_movemask_ps(deeper)) << base;
   const LaneMask uncertain =
       (static_cast<LaneMask>(_mm256_movemask_ps(_mm256_cmp_ps(_mm256_and_ps(depth, v.no_sign), v.band, _CMP_LE_OQ)))
@@ -784,11 +808,16 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
     }
     const PointLanes p = point_lanes(leaf, tip, base);  // the lanes load_lanes would store, not stored
     const __m256 x = p.x, y = p.y, z = p.z;
-    const SurfaceLanes s = surface_lanes<Kind>(c, x, y, z);
-    const __m256 raw = region_depths(verdicts, leaf, base, s, valid, check, penetrating, depths);
+    const SurfaceFunction f = surface_function_lanes<Kind>(c, x, y, z);
+    const __m256 raw = region_depths(verdicts, leaf, base, f.f, valid, check, penetrating, depths);
     const __m256 d = full ? raw : _mm256_and_ps(below_count(leaf, base), raw);
     _mm256_store_ps(depths.data() + base, d);
-    forces.add(leaf, base, x, y, z, d, s);
+    // Eight lanes none of which penetrates add only zeros to the sums, which are never -0 (they
+    // start at +0, and x + -x is +0): the same bits without their escape directions and forces.
+    if (_mm256_movemask_ps(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_NEQ_UQ)) == 0) {
+      continue;
+    }
+    forces.add(leaf, base, x, y, z, d, escape_of<Kind>(c, f, x, y));
   }
   if (!std::isfinite(reduce_sum(check))) {
     return false;
@@ -843,7 +872,7 @@ struct SplitSide {
       return _mm256_setzero_ps();
     }
     s = any_surface_lanes(surface->kind, c, x, y, z);
-    return region_depths(verdicts, leaf, base, s, mine, check, penetrating, depths);
+    return region_depths(verdicts, leaf, base, s.f, mine, check, penetrating, depths);
   }
 
   [[nodiscard]] bool finite() const { return surface == nullptr || std::isfinite(reduce_sum(check)); }
