@@ -368,7 +368,7 @@ LeafContacts without_lanes(const LeafContacts& loaded) {
 // The one-pass force against the two steps, on the leaf as loaded: region_leaf_force against
 // region_leaf_contacts then leaf_forces, or for a leaf split at a plane split_leaf_force against
 // split_leaf_contacts then leaf_forces. The same count, deepest lane and depth (when searched) and
-// the same bits of force and torque.
+// the same bits of force and torque; and region_leaf_deepest's count, lane and depth.
 void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometry::BoxClassification& cover,
                                     const LeafContacts& loaded) {
   const bool split = cover.cover == geometry::BoxCover::SplitAtZ;
@@ -388,6 +388,16 @@ void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometr
     LONGS_EQUAL(find_deepest ? step_by_step.deepest_lane : 0U, one_pass.deepest_lane);
     CHECK(sums.force == one_pass.sums.force);  // the same bits, not merely close
     CHECK(sums.torque == one_pass.sums.torque);
+  }
+  if (!split) {
+    // The search for a deep leaf's deepest point: the same count, lane and depth, and no force.
+    LeafContacts leaf = without_lanes(loaded);
+    RegionLeafForce deepest{};
+    CHECK(region_leaf_deepest(tool, cover.region, leaf, deepest));
+    LONGS_EQUAL(step_by_step.penetrating, deepest.penetrating);
+    DOUBLES_EQUAL(step_by_step.max_depth_mm, deepest.max_depth_mm, 0.0);
+    LONGS_EQUAL(step_by_step.deepest_lane, deepest.deepest_lane);
+    CHECK(deepest.sums.force == Eigen::Vector3d::Zero() && deepest.sums.torque == Eigen::Vector3d::Zero());
   }
 }
 
@@ -566,6 +576,7 @@ TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {
   load_leaf(points.part, points.packed(), kTip, leaf);
   RegionLeafForce out{};
   CHECK_FALSE(region_leaf_force(damaged, cover.region, false, true, 10.0, 7.5, leaf, out));
+  CHECK_FALSE(region_leaf_deepest(damaged, cover.region, leaf, out));
 }
 
 TEST(LeafContacts, ADamagedSurfaceOnEitherSideIsAFaultInTheOnePassSplitForceToo) {

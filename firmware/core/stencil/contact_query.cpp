@@ -377,13 +377,14 @@ ContactResult query_contacts(const tables::PartTables& part, const ToolPose& pos
   };
   LeafContacts searched;
   const auto search_deepest = [&](std::uint32_t leaf_index, std::uint8_t region) {
-    load_leaf(part, part.leaves[leaf_index], pose.tip_mm, searched);
-    if (!region_leaf_contacts(part.tool, region, false, searched)) {
+    bind_leaf(part, part.leaves[leaf_index], leaf_tip(pose.tip_mm), searched);
+    RegionLeafForce deepest{};
+    if (!region_leaf_deepest(part.tool, region, searched, deepest)) {
       return false;
     }
-    if (searched.penetrating > 0 && may_beat(searched.max_depth_mm, searched.first + searched.deepest_lane)) {
-      result.max_depth_mm = searched.max_depth_mm;
-      result.deepest_point = searched.first + searched.deepest_lane;
+    if (deepest.penetrating > 0 && may_beat(deepest.max_depth_mm, searched.first + deepest.deepest_lane)) {
+      result.max_depth_mm = deepest.max_depth_mm;
+      result.deepest_point = searched.first + deepest.deepest_lane;
     }
     return true;
   };

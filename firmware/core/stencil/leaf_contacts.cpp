@@ -785,7 +785,8 @@ template <SurfaceKind Kind>
   return shallow | (0xFU & ~((1U << groups) - 1U));
 }
 
-template <SurfaceKind Kind>
+// kForce false: the depths and the deepest lane alone (region_leaf_deepest), no direction or force.
+template <SurfaceKind Kind, bool kForce = true>
 bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deepest, double k_world,
                         double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
   const SurfaceConstants c = constants_of(surface);
@@ -814,7 +815,7 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
     _mm256_store_ps(depths.data() + base, d);
     // Eight lanes none of which penetrates add only zeros to the sums, which are never -0 (they
     // start at +0, and x + -x is +0): the same bits without their escape directions and forces.
-    if (_mm256_movemask_ps(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_NEQ_UQ)) == 0) {
+    if (!kForce || _mm256_movemask_ps(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_NEQ_UQ)) == 0) {
       continue;
     }
     forces.add(leaf, base, x, y, z, d, escape_of<Kind>(c, f, x, y));
@@ -977,6 +978,32 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
     return false;
   }
   out = settled_leaf_force(leaf, find_deepest, k_world, centre_height_mm);
+  return true;
+#endif
+}
+
+bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, LeafContacts& leaf, RegionLeafForce& out) {
+  const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
+#if defined(__AVX2__)
+  switch (surface.kind) {
+    case SurfaceKind::PlaneZ:
+      return region_force_lanes<SurfaceKind::PlaneZ, false>(surface, true, 0.0, 0.0, leaf, out);
+    case SurfaceKind::Cylinder:
+      return region_force_lanes<SurfaceKind::Cylinder, false>(surface, true, 0.0, 0.0, leaf, out);
+    case SurfaceKind::Sphere:
+      return region_force_lanes<SurfaceKind::Sphere, false>(surface, true, 0.0, 0.0, leaf, out);
+    case SurfaceKind::Torus:
+      return region_force_lanes<SurfaceKind::Torus, false>(surface, true, 0.0, 0.0, leaf, out);
+  }
+  return false;
+#else
+  static_cast<void>(surface);
+  load_lanes(leaf);
+  if (!region_leaf_contacts(tool, region, false, leaf)) {
+    return false;
+  }
+  out = {leaf.penetrating, leaf.penetrating > 0 ? leaf.max_depth_mm : 0.0, leaf.deepest_lane,
+         {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()}};
   return true;
 #endif
 }

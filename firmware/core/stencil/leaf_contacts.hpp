@@ -122,6 +122,12 @@ struct RegionLeafForce {
                                      bool find_deepest, double k_world, double centre_height_mm,
                                      LeafContacts& leaf, RegionLeafForce& out);
 
+// The deepest lane of a leaf (bound by bind_leaf) wholly in region `region`, as
+// region_leaf_contacts finds it, and how many lanes penetrate: region_leaf_force's depths with
+// find_deepest, without the directions and the force (sums zero). False on a non-finite result.
+[[nodiscard]] bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, LeafContacts& leaf,
+                                       RegionLeafForce& out);
+
 // split_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (bound by
 // bind_leaf) straddles the partition plane of `cover` (SplitAtZ), each lane settled by its own
 // side's region. The same numbers, bit for bit, as the two steps, as region_leaf_force gives.
