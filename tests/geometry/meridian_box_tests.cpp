@@ -300,10 +300,14 @@ TEST(MeridianBox, TheDepthSpanWithoutASqrtAgreesWithTheDepthRangeAndLeavesOnlyWh
               CHECK_TEXT(range.deepest_mm < shallow, sample.name);
               ++answered;
               break;
-            case DepthSpan::Between:
+            case DepthSpan::Between: {
               CHECK_TEXT(range.deepest_mm >= shallow && range.shallowest_mm <= deep, sample.name);
+              // The leaf's bound: never below the range's, and off it by no more than 1e-12 of the reach.
+              const double bound = span.deepest_bound(low, high);
+              CHECK_TEXT(bound >= range.deepest_mm && bound - range.deepest_mm <= 1e-11, sample.name);
               ++answered;
               break;
+            }
             case DepthSpan::Unsure:
               // Left to the sqrt: a torus, a side whose solid is outside it, a box wholly deeper
               // than `deep` (the walk wants its numbers), or one within rounding of a threshold.

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 
 #include "firmware/core/geometry/implicit_surface.hpp"
 #include "firmware/core/geometry/tool_bsp.hpp"
@@ -203,30 +204,58 @@ class UprightDepthSpan {
       }
       return range.high >= shallow_mm_ && range.low <= deep_mm_ ? DepthSpan::Between : DepthSpan::Unsure;
     }
+    const Reach reach = reach_of(low, high);
+    if (reach.near_squared > skip_above_) {
+      return DepthSpan::Shallower;
+    }
+    return reach.near_squared < skip_below_ && reach.far_squared > deep_above_ ? DepthSpan::Between : DepthSpan::Unsure;
+  }
+
+  // Of a box told Between, a bound no less than region_depth_range's deepest_mm, for the walk's
+  // question whether a leaf's point may be the deepest found: the same number for a plane; for a
+  // ball or a side the nearest point's depth with its distance shortened by 1e-12 of itself, past
+  // the rounding of either way of computing it.
+  [[nodiscard]] double deepest_bound(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const {
+    if (kind_ == Kind::Plane) {
+      return meridian_box_detail::interior_range(*surface_, {0.0, 0.0, low.z() - tip_mm_.z(), high.z() - tip_mm_.z()}).high;
+    }
+    if (kind_ == Kind::Unsure) {
+      return std::numeric_limits<double>::infinity();
+    }
+    return surface_->radius_mm - std::sqrt(reach_of(low, high).near_squared) * (1.0 - 1e-12);
+  }
+
+ private:
+  enum class Kind : std::uint8_t { Unsure, Plane, Ball, Side };
+
+  // The squared distance of the box's nearest and farthest points from the ball's centre, or
+  // from the axis for a side.
+  struct Reach {
+    double near_squared;
+    double far_squared;
+  };
+  [[gnu::always_inline]] Reach reach_of(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const {
     const double x_low = low.x() - tip_mm_.x();
     const double x_high = high.x() - tip_mm_.x();
     const double y_low = low.y() - tip_mm_.y();
     const double y_high = high.y() - tip_mm_.y();
     const double near_x = std::min(std::max(0.0, x_low), x_high);
     const double near_y = std::min(std::max(0.0, y_low), y_high);
-    double near_squared = near_x * near_x + near_y * near_y;
-    double far_squared = std::max(x_low * x_low, x_high * x_high) + std::max(y_low * y_low, y_high * y_high);
+    Reach reach{near_x * near_x + near_y * near_y,
+                std::max(x_low * x_low, x_high * x_high) + std::max(y_low * y_low, y_high * y_high)};
     if (kind_ == Kind::Ball) {
       const double centre_z = surface_->center_z_mm;
+      const double z_low = low.z() - tip_mm_.z();
+      const double z_high = high.z() - tip_mm_.z();
       const double near_dz = std::min(std::max(centre_z, z_low), z_high) - centre_z;
       const double dz_low = z_low - centre_z;
       const double dz_high = z_high - centre_z;
-      near_squared += near_dz * near_dz;
-      far_squared += std::max(dz_low * dz_low, dz_high * dz_high);
+      reach.near_squared += near_dz * near_dz;
+      reach.far_squared += std::max(dz_low * dz_low, dz_high * dz_high);
     }
-    if (near_squared > skip_above_) {
-      return DepthSpan::Shallower;
-    }
-    return near_squared < skip_below_ && far_squared > deep_above_ ? DepthSpan::Between : DepthSpan::Unsure;
+    return reach;
   }
 
- private:
-  enum class Kind : std::uint8_t { Unsure, Plane, Ball, Side };
   const ImplicitSurface* surface_;
   Eigen::Vector3d tip_mm_;
   double shallow_mm_;

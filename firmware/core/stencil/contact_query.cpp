@@ -227,15 +227,21 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         }
         continue;
       }
-      const geometry::DepthRange range =
-          geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
-      if (shallower_than_penetration(range.deepest_mm)) {
-        continue;
-      }
       cover.cover = pending.settled;
       cover.region = pending.region;
-      cover.deepest_bound_mm = range.deepest_mm;
-      shallowest_mm = range.shallowest_mm;
+      if (span == geometry::DepthSpan::Between) {
+        // A leaf not wholly deep: its bound only asks whether one of its points may be the
+        // deepest, and one no less than the range's gives the same answer.
+        cover.deepest_bound_mm = span_of->deepest_bound(low, high);
+      } else {
+        const geometry::DepthRange range =
+            geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
+        if (shallower_than_penetration(range.deepest_mm)) {
+          continue;
+        }
+        cover.deepest_bound_mm = range.deepest_mm;
+        shallowest_mm = range.shallowest_mm;
+      }
     } else if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
     }
