@@ -128,10 +128,16 @@ inline DepthRange region_depth_range(const ToolBsp& tool, std::uint8_t region, c
   return {range.low, range.high};
 }
 
-inline MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
-                                        const Eigen::Vector3d& high) {
-  // Subtraction, squaring, addition and sqrt are each monotonic, so the nearest and farthest
-  // points of the box's footprint bound every point's r as the query rounds it.
+namespace meridian_box_detail {
+
+// The squared distances from the upright axis through the tip of the nearest and the farthest
+// point of the box's footprint.
+struct Footprint {
+  double near_squared;
+  double far_squared;
+};
+[[gnu::always_inline]] inline Footprint footprint(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
+                                                  const Eigen::Vector3d& high) {
   const double x_low = low.x() - tip_mm.x();
   const double x_high = high.x() - tip_mm.x();
   const double y_low = low.y() - tip_mm.y();
@@ -140,8 +146,17 @@ inline MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eig
   const double near_y = std::min(std::max(0.0, y_low), y_high);
   const double far_x = std::max(x_low * x_low, x_high * x_high);
   const double far_y = std::max(y_low * y_low, y_high * y_high);
-  return {std::sqrt(near_x * near_x + near_y * near_y), std::sqrt(far_x + far_y), low.z() - tip_mm.z(),
-          high.z() - tip_mm.z()};
+  return {near_x * near_x + near_y * near_y, far_x + far_y};
+}
+
+}  // namespace meridian_box_detail
+
+inline MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& low,
+                                        const Eigen::Vector3d& high) {
+  // Subtraction, squaring, addition and sqrt are each monotonic, so the nearest and farthest
+  // points of the box's footprint bound every point's r as the query rounds it.
+  const meridian_box_detail::Footprint f = meridian_box_detail::footprint(tip_mm, low, high);
+  return {std::sqrt(f.near_squared), std::sqrt(f.far_squared), low.z() - tip_mm.z(), high.z() - tip_mm.z()};
 }
 
 
@@ -235,14 +250,8 @@ class UprightDepthSpan {
     double far_squared;
   };
   [[gnu::always_inline]] Reach reach_of(const Eigen::Vector3d& low, const Eigen::Vector3d& high) const {
-    const double x_low = low.x() - tip_mm_.x();
-    const double x_high = high.x() - tip_mm_.x();
-    const double y_low = low.y() - tip_mm_.y();
-    const double y_high = high.y() - tip_mm_.y();
-    const double near_x = std::min(std::max(0.0, x_low), x_high);
-    const double near_y = std::min(std::max(0.0, y_low), y_high);
-    Reach reach{near_x * near_x + near_y * near_y,
-                std::max(x_low * x_low, x_high * x_high) + std::max(y_low * y_low, y_high * y_high)};
+    const meridian_box_detail::Footprint f = meridian_box_detail::footprint(tip_mm_, low, high);
+    Reach reach{f.near_squared, f.far_squared};
     if (kind_ == Kind::Ball) {
       const double centre_z = surface_->center_z_mm;
       const double z_low = low.z() - tip_mm_.z();
