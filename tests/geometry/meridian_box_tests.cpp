@@ -324,37 +324,62 @@ TEST(MeridianBox, TheDepthSpanWithoutASqrtAgreesWithTheDepthRangeAndLeavesOnlyWh
   }
 }
 
-// Boxes whose nearest or farthest point lies within a few units of rounding of a threshold: the
-// span answers them as the sqrt does, or not at all.
-TEST(MeridianBox, TheDepthSpanLeavesABoxAtAThresholdToTheSqrt) {
+// A point at a given distance from a ball's centre (straight below it) or from a side's axis: its
+// depth is the radius less that distance, give or take rounding. Boxes of one point within a few
+// units of rounding of a threshold are answered as the sqrt answers them, or not at all; a
+// micrometre either side of it, they are answered; a surface whose numbers are not finite is not.
+TEST(MeridianBox, TheDepthSpanAnswersAMicrometreFromAThresholdAndLeavesRoundingToTheSqrt) {
   ToolBsp tool{};
-  CHECK(build_tool_bsp(kSampleTools[2].spec, tool).ok);  // ball d3: the hemisphere's centre 1.5 above the tip
+  CHECK(build_tool_bsp(kSampleTools[2].spec, tool).ok);  // ball d3: a hemisphere under the flutes' side
   const Eigen::Vector3d tip(20.0, -7.5, 3.25);
-  int unsure = 0;
+  const double shallow = 0.1;
+  const double deep = 0.3;
+  int kinds = 0;
   for (std::uint8_t region = 0; region < tool.region_count; ++region) {
     const ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
-    if (surface.kind != SurfaceKind::Sphere) {
+    if (surface.kind != SurfaceKind::Sphere && surface.kind != SurfaceKind::Cylinder) {
       continue;
     }
-    const double shallow = 0.5 * kSurfaceTolerance_mm;
-    const double deep = kSurfaceTolerance_mm;
+    ++kinds;
     const UprightDepthSpan span(tool, region, tip, shallow, deep);
-    // A point straight below the centre at the radius less `depth`: its depth is `depth`, give or take rounding.
-    for (const double depth : {shallow, deep}) {
+    const auto at_distance = [&](double distance) -> Eigen::Vector3d {
+      return surface.kind == SurfaceKind::Sphere ? tip + Eigen::Vector3d(0.0, 0.0, surface.center_z_mm - distance)
+                                                 : tip + Eigen::Vector3d(distance, 0.0, 5.0);
+    };
+    const auto answer = [&](double distance) {
+      const Eigen::Vector3d p = at_distance(distance);
+      const DepthRange range = region_depth_range(tool, region, upright_meridian_box(tip, p, p));
+      const DepthSpan told = span(p, p);
+      if (told == DepthSpan::Shallower) {
+        CHECK(range.deepest_mm < shallow);
+      } else if (told == DepthSpan::Between) {
+        CHECK(range.deepest_mm >= shallow && range.shallowest_mm <= deep);
+      }
+      return told;
+    };
+    for (const double threshold : {shallow, deep}) {
       for (int ulps = -4; ulps <= 4; ++ulps) {
-        const double z = tip.z() + surface.center_z_mm - (surface.radius_mm - depth) + ulps * 4e-16;
-        const Eigen::Vector3d low(tip.x(), tip.y(), z);
-        const Eigen::Vector3d high(tip.x() + 1e-3, tip.y() + 1e-3, z);
-        const DepthRange range = region_depth_range(tool, region, upright_meridian_box(tip, low, high));
-        const DepthSpan answer = span(low, high);
-        unsure += answer == DepthSpan::Unsure ? 1 : 0;
-        if (answer == DepthSpan::Shallower) {
-          CHECK(range.deepest_mm < shallow);
-        } else if (answer == DepthSpan::Between) {
-          CHECK(range.deepest_mm >= shallow && range.shallowest_mm <= deep);
-        }
+        static_cast<void>(answer(surface.radius_mm - threshold + ulps * 4e-16));
       }
     }
+    // A micrometre from each threshold: shallow beyond the first, between the two, wholly deep
+    // (the walk's sqrt, for its numbers) beyond the second.
+    CHECK(answer(surface.radius_mm - shallow + 1e-6) == DepthSpan::Shallower);
+    CHECK(answer(surface.radius_mm - shallow - 1e-6) == DepthSpan::Between);
+    CHECK(answer(surface.radius_mm - deep + 1e-6) == DepthSpan::Between);
+    CHECK(answer(surface.radius_mm - deep - 1e-6) == DepthSpan::Unsure);
+    // A radius that is not a number: no answer. A centre at infinity: the sqrt's answer (every
+    // point infinitely far, so shallow) or none.
+    ToolBsp damaged = tool;
+    damaged.surfaces[damaged.regions[region].surface].radius_mm = std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Vector3d p = at_distance(surface.radius_mm - 0.2);
+    CHECK(UprightDepthSpan(damaged, region, tip, shallow, deep)(p, p) == DepthSpan::Unsure);
+    damaged = tool;
+    damaged.surfaces[damaged.regions[region].surface].center_z_mm = std::numeric_limits<double>::infinity();
+    const DepthSpan far_centre = UprightDepthSpan(damaged, region, tip, shallow, deep)(p, p);
+    const DepthRange far_range = region_depth_range(damaged, region, upright_meridian_box(tip, p, p));
+    CHECK(far_centre != DepthSpan::Shallower || far_range.deepest_mm < shallow);
+    CHECK(far_centre != DepthSpan::Between || (far_range.deepest_mm >= shallow && far_range.shallowest_mm <= deep));
   }
-  CHECK(unsure >= 9);  // at least the nine boxes at the skipping threshold
+  LONGS_EQUAL(3, kinds);  // the ball, the flutes' side and the holder's
 }

@@ -552,6 +552,28 @@ TEST(LeafContacts, TheOnePassForceSkipsAGroupThatCannotPenetrateAndGivesTheSteps
   check_one_pass_is_step_by_step(tool, cover, leaf);
 }
 
+TEST(LeafContacts, TheOnePassForceSkipsEightLanesNoneOfWhichPenetratesAndGivesTheStepsBits) {
+  // Across the bottom of the ball: in every group of 16 lanes, the first eight just inside it and
+  // the next eight just below the tip, outside. No group is skipped whole (each holds penetrating
+  // lanes); every second eight lanes adds no force, and the one pass leaves their force out.
+  LeafPoints points(Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero(), tables::kMaxLeafPoints);
+  for (std::uint32_t i = 0; i < points.count; ++i) {
+    const double t = static_cast<double>(i);
+    const bool inside = (i / 8) % 2 == 0;
+    const Eigen::Vector3d p = kTip + Eigen::Vector3d(0.04 * std::sin(1.7 * t), 0.04 * std::cos(2.3 * t),
+                                                     (inside ? 0.03 : -0.02) + 0.005 * std::sin(0.9 * t));
+    points.points[i] = {static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z())};
+  }
+  const geometry::BoxClassification cover = geometry::classify_meridian_box(tool, points.box());
+  CHECK(cover.cover == geometry::BoxCover::RegionOrOutside);
+  load_leaf(points.part, points.packed(), kTip, leaf);
+  LeafContacts steps = leaf;
+  CHECK(region_leaf_contacts(tool, cover.region, true, steps));
+  const LaneMask inside_lanes = 0x00FF00FF00FF00FFULL;
+  CHECK_EQUAL(inside_lanes, steps.penetrating_lanes);  // every first eight, and none of the next
+  check_one_pass_is_step_by_step(tool, cover, leaf);
+}
+
 TEST(LeafContacts, EveryLaneOfAFullLeafIsSettledAsTheTreeSettlesItsPoint) {
   // The lanes past 32 too: a leaf of kMaxLeafPoints points each way a leaf is settled.
   check_leaf(LeafPoints(Eigen::Vector3d(0.2, 0.1, 0.6), Eigen::Vector3d(0.15, 0.15, 0.1), tables::kMaxLeafPoints),

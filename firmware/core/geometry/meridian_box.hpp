@@ -159,15 +159,16 @@ inline MeridianBox upright_meridian_box(const Eigen::Vector3d& tip_mm, const Eig
   return {std::sqrt(f.near_squared), std::sqrt(f.far_squared), low.z() - tip_mm.z(), high.z() - tip_mm.z()};
 }
 
-
 // Between which depths a node's box lies, told without a sqrt where the rounding cannot matter: the
 // walk of the points' tree asks it of every node under a settled one, and most of them are told
 // apart here, without the two sqrts in a chain that region_depth_range takes for a ball or a side.
 enum class DepthSpan : std::uint8_t {
   Shallower,  // region_depth_range(tool, region, upright_meridian_box(tip, low, high)) has deepest_mm < shallow_mm
   Between,    // ... has deepest_mm >= shallow_mm and shallowest_mm <= deep_mm
-  Unsure,     // ask region_depth_range: too near either threshold, a torus, a solid above its surface,
-              // a threshold past half the radius, or numbers that are not finite
+  Unsure,     // ask region_depth_range: too near either threshold, wholly deeper than deep_mm, a
+              // torus, a solid above its surface, a threshold past half the radius, or a radius that
+              // is not finite. An answer is given only where region_depth_range's numbers give the
+              // same one, numbers that are not finite included (a centre at infinity: shallow).
 };
 
 // For a plane, region_depth_range's own arithmetic (it needs no radius). For a ball centred on the

@@ -212,7 +212,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
     if (settled) {
       // Most nodes under a settled one are told shallow, or between the thresholds (a node to walk
-      // into), without region_depth_range's sqrts: the same answers (upright_depth_span).
+      // into), without region_depth_range's sqrts: the same answers (UprightDepthSpan).
       if (!span_of || span_of->region() != pending.region) {
         span_of.emplace(tool, pending.region, pose.tip_mm, 0.5 * geometry::kSurfaceTolerance_mm,
                         geometry::kSurfaceTolerance_mm);

@@ -813,8 +813,10 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
     const __m256 raw = region_depths(verdicts, leaf, base, f.f, valid, check, penetrating, depths);
     const __m256 d = full ? raw : _mm256_and_ps(below_count(leaf, base), raw);
     _mm256_store_ps(depths.data() + base, d);
-    // Eight lanes none of which penetrates add only zeros to the sums, which are never -0 (they
-    // start at +0, and x + -x is +0): the same bits without their escape directions and forces.
+    // Eight lanes none of which penetrates add only zeros to the sums (with k and the centre's
+    // height finite, as the skip of shallow groups above already takes them), which are never -0
+    // (they start at +0, and x + -x is +0 rounding to nearest): the same bits without their escape
+    // directions and forces.
     if (!kForce || _mm256_movemask_ps(_mm256_cmp_ps(d, _mm256_setzero_ps(), _CMP_NEQ_UQ)) == 0) {
       continue;
     }
