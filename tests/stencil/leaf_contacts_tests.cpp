@@ -393,11 +393,26 @@ void check_one_pass_is_step_by_step(const geometry::ToolBsp& tool, const geometr
     // The search for a deep leaf's deepest point: the same count, lane and depth, and no force.
     LeafContacts leaf = without_lanes(loaded);
     RegionLeafForce deepest{};
-    CHECK(region_leaf_deepest(tool, cover.region, leaf, deepest));
+    CHECK(region_leaf_deepest(tool, cover.region, -std::numeric_limits<double>::infinity(), leaf, deepest));
     LONGS_EQUAL(step_by_step.penetrating, deepest.penetrating);
     DOUBLES_EQUAL(step_by_step.max_depth_mm, deepest.max_depth_mm, 0.0);
     LONGS_EQUAL(step_by_step.deepest_lane, deepest.deepest_lane);
     CHECK(deepest.sums.force == Eigen::Vector3d::Zero() && deepest.sums.torque == Eigen::Vector3d::Zero());
+    // With the deepest depth as the floor, the group holding the deepest lane stays: the same lane
+    // and depth, from no more lanes than penetrate.
+    leaf = without_lanes(loaded);
+    CHECK(region_leaf_deepest(tool, cover.region, step_by_step.max_depth_mm, leaf, deepest));
+    CHECK(deepest.penetrating > 0 && deepest.penetrating <= step_by_step.penetrating);
+    DOUBLES_EQUAL(step_by_step.max_depth_mm, deepest.max_depth_mm, 0.0);
+    LONGS_EQUAL(step_by_step.deepest_lane, deepest.deepest_lane);
+    // Above every point, every group is left out (with the lanes; without them, none is).
+    leaf = without_lanes(loaded);
+    CHECK(region_leaf_deepest(tool, cover.region, std::numeric_limits<double>::infinity(), leaf, deepest));
+#if defined(__AVX2__)
+    LONGS_EQUAL(0, deepest.penetrating);
+#else
+    LONGS_EQUAL(step_by_step.penetrating, deepest.penetrating);
+#endif
   }
 }
 
@@ -598,7 +613,9 @@ TEST(LeafContacts, ADamagedRegionSurfaceIsAFaultInTheOnePassForceToo) {
   load_leaf(points.part, points.packed(), kTip, leaf);
   RegionLeafForce out{};
   CHECK_FALSE(region_leaf_force(damaged, cover.region, false, true, 10.0, 7.5, leaf, out));
-  CHECK_FALSE(region_leaf_deepest(damaged, cover.region, leaf, out));
+  CHECK_FALSE(region_leaf_deepest(damaged, cover.region, -std::numeric_limits<double>::infinity(), leaf, out));
+  // A floor leaves out no group whose bound is not finite: the fault is still found.
+  CHECK_FALSE(region_leaf_deepest(damaged, cover.region, std::numeric_limits<double>::infinity(), leaf, out));
 }
 
 TEST(LeafContacts, ADamagedSurfaceOnEitherSideIsAFaultInTheOnePassSplitForceToo) {

@@ -766,10 +766,11 @@ template <SurfaceKind Kind>
 }
 
 // The groups of a leaf in one region that no point of can penetrate (its depth at the centroid
-// plus its radius, the depth changing no faster than the point moves, is within the tolerance),
-// and the groups past its points: bit g for group g.
+// plus its radius, the depth changing no faster than the point moves, is within the tolerance), or
+// reach floor_mm (-infinity: none), and the groups past its points: bit g for group g.
 template <SurfaceKind Kind>
-[[gnu::always_inline]] inline unsigned shallow_groups(const geometry::ImplicitSurface& surface, const LeafContacts& leaf) {
+[[gnu::always_inline]] inline unsigned shallow_groups(const geometry::ImplicitSurface& surface, const LeafContacts& leaf,
+                                                      double floor_mm) {
   const tables::LeafBlock& block = *leaf.normals;
   const GroupGeometry g = group_geometry<Kind>(surface, block, leaf.tip_mm);
   // A margin for the rounding of the one depth: about 1e-13 mm for a workspace a metre across.
@@ -779,16 +780,19 @@ template <SurfaceKind Kind>
   // check fails.
   const __m256d finite = _mm256_cmp_pd(_mm256_and_pd(deepest, _mm256_castsi256_pd(_mm256_set1_epi64x(0x7fffffffffffffff))),
                                        _mm256_set1_pd(std::numeric_limits<double>::max()), _CMP_LE_OQ);
-  const unsigned shallow = static_cast<unsigned>(_mm256_movemask_pd(
-      _mm256_and_pd(finite, _mm256_cmp_pd(deepest, _mm256_set1_pd(geometry::kSurfaceTolerance_mm), _CMP_LE_OQ))));
+  const __m256d below = _mm256_or_pd(_mm256_cmp_pd(deepest, _mm256_set1_pd(geometry::kSurfaceTolerance_mm), _CMP_LE_OQ),
+                                     _mm256_cmp_pd(deepest, _mm256_set1_pd(floor_mm), _CMP_LT_OQ));
+  const unsigned shallow = static_cast<unsigned>(_mm256_movemask_pd(_mm256_and_pd(finite, below)));
   const unsigned groups = (leaf.count + tables::kLeafGroupPoints - 1) / tables::kLeafGroupPoints;
   return shallow | (0xFU & ~((1U << groups) - 1U));
 }
 
-// kForce false: the depths and the deepest lane alone (region_leaf_deepest), no direction or force.
+// kForce false: the depths and the deepest lane alone (region_leaf_deepest), no direction or force,
+// leaving out the groups that cannot reach floor_mm as if shallow.
 template <SurfaceKind Kind, bool kForce = true>
 bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deepest, double k_world,
-                        double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out) {
+                        double centre_height_mm, const LeafContacts& leaf, RegionLeafForce& out,
+                        double floor_mm = -std::numeric_limits<double>::infinity()) {
   const SurfaceConstants c = constants_of(surface);
   const float band = band_for(leaf, surface);
   const RegionVerdicts verdicts = verdicts_of(surface, band);
@@ -799,7 +803,8 @@ bool region_force_lanes(const geometry::ImplicitSurface& surface, bool find_deep
   LaneMask penetrating = 0;
   // A group that cannot penetrate adds nothing: its lanes' depths are 0 either way (within the
   // band of the surface they would be settled in double precision, below it), so their forces.
-  const unsigned shallow = shallow_groups<Kind>(surface, leaf);
+  const unsigned shallow =
+      shallow_groups<Kind>(surface, leaf, kForce ? -std::numeric_limits<double>::infinity() : floor_mm);
   const TipLanes tip = tip_lanes(leaf);
   const bool full = leaf.count >= kLanes;  // no lane past the count to clear
   for (std::uint32_t base = 0; base < kLanes; base += 8) {
@@ -984,22 +989,24 @@ bool region_leaf_force(const geometry::ToolBsp& tool, std::uint8_t region, bool 
 #endif
 }
 
-bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, LeafContacts& leaf, RegionLeafForce& out) {
+bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, double floor_mm, LeafContacts& leaf,
+                         RegionLeafForce& out) {
   const geometry::ImplicitSurface& surface = tool.surfaces[tool.regions[region].surface];
 #if defined(__AVX2__)
   switch (surface.kind) {
     case SurfaceKind::PlaneZ:
-      return region_force_lanes<SurfaceKind::PlaneZ, false>(surface, true, 0.0, 0.0, leaf, out);
+      return region_force_lanes<SurfaceKind::PlaneZ, false>(surface, true, 0.0, 0.0, leaf, out, floor_mm);
     case SurfaceKind::Cylinder:
-      return region_force_lanes<SurfaceKind::Cylinder, false>(surface, true, 0.0, 0.0, leaf, out);
+      return region_force_lanes<SurfaceKind::Cylinder, false>(surface, true, 0.0, 0.0, leaf, out, floor_mm);
     case SurfaceKind::Sphere:
-      return region_force_lanes<SurfaceKind::Sphere, false>(surface, true, 0.0, 0.0, leaf, out);
+      return region_force_lanes<SurfaceKind::Sphere, false>(surface, true, 0.0, 0.0, leaf, out, floor_mm);
     case SurfaceKind::Torus:
-      return region_force_lanes<SurfaceKind::Torus, false>(surface, true, 0.0, 0.0, leaf, out);
+      return region_force_lanes<SurfaceKind::Torus, false>(surface, true, 0.0, 0.0, leaf, out, floor_mm);
   }
   return false;
 #else
   static_cast<void>(surface);
+  static_cast<void>(floor_mm);  // every group taken: the lanes' answer leaves none out
   load_lanes(leaf);
   if (!region_leaf_contacts(tool, region, false, leaf)) {
     return false;

@@ -124,9 +124,13 @@ struct RegionLeafForce {
 
 // The deepest lane of a leaf (bound by bind_leaf) wholly in region `region`, as
 // region_leaf_contacts finds it, and how many lanes penetrate: region_leaf_force's depths with
-// find_deepest, without the directions and the force (sums zero). False on a non-finite result.
-[[nodiscard]] bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, LeafContacts& leaf,
-                                       RegionLeafForce& out);
+// find_deepest, without the directions and the force (sums zero). Groups of lanes
+// (tables::kLeafGroupPoints) whose every point is shallower than floor_mm by the group's own bound
+// (its centroid's depth plus its radius) may be left out, as if none of their lanes penetrated:
+// for a search that only wants a point deeper than floor_mm, or as deep and earlier. -infinity
+// leaves none out. False on a non-finite result.
+[[nodiscard]] bool region_leaf_deepest(const geometry::ToolBsp& tool, std::uint8_t region, double floor_mm,
+                                       LeafContacts& leaf, RegionLeafForce& out);
 
 // split_leaf_contacts and leaf_forces in one pass, for the query's force: the leaf (bound by
 // bind_leaf) straddles the partition plane of `cover` (SplitAtZ), each lane settled by its own
