@@ -115,6 +115,41 @@ TEST(ContactQuery, APoseThatIsNotANumberIsRefusedNotAnswered) {
   CHECK(check_legal(part, upright_at(25.0, nan, 3.0)) == Legality::Fault);
 }
 
+// Tables that did not come through the loader: a node whose right child is itself. Wherever the
+// walk meets it, in the tree's mixed nodes or in a subtree settled in one region, it ends in a bad
+// tree (its stack, as deep as the loader allows trees to be, fills) rather than looping or writing
+// past its stack; where the walk never opens it, the answer is the sound tree's.
+TEST(ContactQuery, ANodeThatIsItsOwnChildEndsTheWalkAsABadTreeWhereverTheWalkMeetsIt) {
+  const ToolPose pose = upright_at(25.3, 12.1, kTop_mm - 0.2);
+  const ContactResult sound = query_contacts(part, pose, parameters);
+  CHECK(sound.status == QueryStatus::Ok && sound.penetrating_points > 0);
+  std::vector<tables::BvhNode> nodes(part.nodes, part.nodes + part.node_count());
+  tables::PartTables damaged = part;
+  damaged.nodes = nodes.data();
+  int bad = 0;
+  for (std::size_t i = 0; i < nodes.size(); ++i) {
+    if (nodes[i].point_count > 0) {
+      continue;
+    }
+    const std::uint32_t right = nodes[i].right_child;
+    nodes[i].right_child = static_cast<std::uint32_t>(i);
+    const ContactResult result = query_contacts(damaged, pose, parameters);
+    const Legality legality = check_legal(damaged, pose);
+    nodes[i].right_child = right;
+    if (result.status == QueryStatus::BadTree) {
+      ++bad;
+      LONGS_EQUAL(0, result.penetrating_points);
+      CHECK(legality == Legality::Fault || legality == Legality::Illegal);  // it may stop at a penetrating leaf first
+    } else {
+      CHECK(result.status == QueryStatus::Ok);
+      CHECK(result.force_n == sound.force_n);
+      LONGS_EQUAL(sound.penetrating_points, result.penetrating_points);
+    }
+  }
+  // The root, the nodes down to the contact, and the settled subtrees' nodes walked into.
+  CHECK(bad > 5);
+}
+
 TEST(ContactQuery, TouchedTrianglesAreThoseNearTheToolOnly) {
   geometry::ToolBsp contact_tool{};
   CHECK(build_contact_tool(part.tool.spec, 0.01, contact_tool));

@@ -96,21 +96,6 @@ LeafVisit settle_region_leaf(const geometry::ToolBsp& tool, const geometry::BoxC
   return visit_leaf(leaf) ? LeafVisit::Continue : LeafVisit::Stop;
 }
 
-// Below a node whose box the upright tool's tree settles in one region (Region), or in it or
-// outside (RegionOrOutside), every node is settled so too as far as penetrating points go: the
-// loader holds each node's DOP inside its parent's, so each point of the subtree either reaches
-// that region, its depth that of the region's surface, or is outside the tool, its depth there
-// below the tolerance. When only penetrating points are wanted, such a subtree is walked with the
-// region and each node's depth bound from that surface alone: no walk of the tool tree, no outline
-// test, the same verdicts, depths and forces. The touched set, which also wants the points on the
-// surface just outside, classifies each leaf itself. This rests on the loader's check of the DOPs
-// (nodes.dop, "inside its parent's DOP"): tables that did not pass the loader get no such promise.
-struct Pending {
-  std::uint32_t index;
-  geometry::BoxCover settled;  // Region or RegionOrOutside: settled by an ancestor; Mixed: not
-  std::uint8_t region;
-};
-
 // A leaf or node whose deepest point cannot be deeper than the tolerance (half of it, so that the
 // lanes' rounding cannot matter) has only touching points, which only the touched set wants.
 bool shallower_than_penetration(double deepest_bound_mm) {
@@ -154,9 +139,13 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
                          VisitRegionLeaf&& visit_region_leaf, VisitDeepLeaf&& visit_deep_leaf) {
   const geometry::Kdop14 volume = geometry::tool_kdop(tool.envelope, pose.tip_mm, pose.axis);
   const bool upright = pose.axis == Eigen::Vector3d::UnitZ();
-  std::array<Pending, tables::kMaxTreeDepth + 1> stack;
+  std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;  // nodes not settled by an ancestor
   std::size_t size = 0;
-  stack[size++] = {0, geometry::BoxCover::Mixed, 0};
+  stack[size++] = 0;
+  // Nodes the walk may still take: each node of a tree is taken once at most, so tables with a
+  // link back up the tree (which the loader refuses) end the walk as a bad tree instead of
+  // looping, and the two loops below are bounded by the node count.
+  std::uint32_t budget = part.node_count();
   LeafContacts leaf;
   // The tip split for the lanes, once a walk, and only when a leaf is met (a query in free space
   // meets none).
@@ -169,8 +158,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     bind_leaf(part, block, tip, leaf);
   };
-  // The node's cover, one object for the walk: a node settled by its ancestor sets only the fields
-  // a Region or RegionOrOutside cover has (the split's fields are read only when classify sets them).
+  // The cover of the node classify_meridian_box last took.
   geometry::BoxClassification cover{geometry::BoxCover::Mixed, 0, 0.0, 0.0, {}, {}};
   // A deep leaf: settled by visit_deep_leaf from its block, or where that cannot, by its points.
   const auto visit_deep = [&](const geometry::BoxClassification& deep_cover, const tables::LeafBlock& block) {
@@ -181,24 +169,125 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     bind_to(block);
     return visit_region_leaf(deep_cover, leaf);
   };
-  // The depth span of settled nodes, set up for the region of the last one met.
-  std::optional<geometry::UprightDepthSpan> span_of;
-  // The node's two children, each settled as `child` says, the left one walked first. False when
-  // the tree is deeper than the loader allows: the tables were not loaded by it.
-  const auto push_children = [&](std::uint32_t index, const tables::BvhNode& node, Pending child) {
-    if (size + 2 > stack.size()) {
-      return false;
+  // The leaf block of leaf node `node`, or nullptr for a leaf the loader would have refused.
+  const auto block_of = [&](const tables::BvhNode& node) -> const tables::LeafBlock* {
+    if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
+        node.point_count > part.point_count() - node.first_point || node.leaf >= part.leaf_count() ||
+        part.leaves[node.leaf].first_point != node.first_point ||
+        part.leaves[node.leaf].point_count != node.point_count) {
+      return nullptr;
     }
-    child.index = node.right_child;
-    stack[size++] = child;
-    child.index = index + 1;
-    stack[size++] = child;
-    return true;
+    return &part.leaves[node.leaf];
+  };
+  // Every leaf of the subtree under node `index`, all of whose points are deep (a run of leaf
+  // blocks, numbered in the walk's order), to visit_deep in that order, with no box below this one
+  // looked at: each with the subtree's cover and bound.
+  const auto visit_deep_run = [&](std::uint32_t index, const geometry::BoxClassification& deep_cover) {
+    LeafRun run{};
+    if (!leaves_below(part, index, run)) {
+      return LeafVisit::Fault;
+    }
+    for (std::uint32_t leaf_index = run.first; leaf_index <= run.last; ++leaf_index) {
+      const tables::LeafBlock& block = part.leaves[leaf_index];
+      if (block.point_count == 0 || block.point_count > tables::kMaxLeafPoints ||
+          block.first_point > part.point_count() || block.point_count > part.point_count() - block.first_point) {
+        return LeafVisit::Fault;  // a block the loader would have refused
+      }
+      const LeafVisit visit = visit_deep(deep_cover, block);
+      if (visit != LeafVisit::Continue) {
+        return visit;
+      }
+    }
+    return LeafVisit::Continue;
+  };
+  // The subtree under node `root` (its children, not itself), settled in `region` as `settled`
+  // says (Region or RegionOrOutside), in the walk's order. Below a node whose box the upright
+  // tool's tree settles so, every node is settled so too as far as penetrating points go: the
+  // loader holds each node's DOP inside its parent's, so each point of the subtree either reaches
+  // that region, its depth that of the region's surface, or is outside the tool, its depth there
+  // below the tolerance. So when only penetrating points are wanted each node is taken by its DOP
+  // and its depth from that surface alone: no walk of the tool tree, no outline test, the same
+  // verdicts, depths and forces. Most nodes are told shallow, or between the thresholds (a node to
+  // walk into), without region_depth_range's sqrts (UprightDepthSpan, the same answers). A loop of
+  // its own, in the order the mixed walk's stack would take the subtree in, with nothing of that
+  // walk's to carry. This rests on the loader's check of the DOPs (nodes.dop, "inside its parent's
+  // DOP"): tables that did not pass the loader get no such promise.
+  const auto walk_settled = [&](std::uint32_t root, const tables::BvhNode& root_node, geometry::BoxCover settled,
+                                std::uint8_t region) {
+    const geometry::UprightDepthSpan span(tool, region, pose.tip_mm, 0.5 * geometry::kSurfaceTolerance_mm,
+                                          geometry::kSurfaceTolerance_mm);
+    geometry::BoxClassification settled_cover{settled, region, 0.0, 0.0, {}, {}};
+    std::array<std::uint32_t, tables::kMaxTreeDepth + 1> pending;
+    std::size_t count = 0;
+    pending[count++] = root_node.right_child;
+    pending[count++] = root + 1;
+    while (count > 0) {
+      const std::uint32_t index = pending[--count];
+      if (index >= part.node_count() || budget-- == 0) {
+        return Walk::BadTree;
+      }
+      const tables::BvhNode& node = part.nodes[index];
+      if (!overlaps_node(volume, node)) {
+        continue;
+      }
+      const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
+      const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
+      const geometry::DepthSpan depth_span = span(low, high);
+      if (depth_span == geometry::DepthSpan::Shallower) {
+        continue;
+      }
+      if (depth_span == geometry::DepthSpan::Between && node.point_count == 0) {
+        if (count + 2 > pending.size()) {
+          return Walk::BadTree;  // deeper than the loader allows
+        }
+        pending[count++] = node.right_child;
+        pending[count++] = index + 1;
+        continue;
+      }
+      double shallowest_mm = -1.0;  // no point is shallower (where known; NaN from a damaged surface)
+      if (depth_span == geometry::DepthSpan::Between) {
+        // A leaf not wholly deep: its bound only asks whether one of its points may be the
+        // deepest, and one no less than the range's gives the same answer.
+        settled_cover.deepest_bound_mm = span.deepest_bound(low, high);
+      } else {
+        const geometry::DepthRange range =
+            geometry::region_depth_range(tool, region, geometry::upright_meridian_box(pose.tip_mm, low, high));
+        if (shallower_than_penetration(range.deepest_mm)) {
+          continue;
+        }
+        settled_cover.deepest_bound_mm = range.deepest_mm;
+        shallowest_mm = range.shallowest_mm;
+      }
+      LeafVisit visit = LeafVisit::Continue;
+      if (node.point_count > 0) {
+        const tables::LeafBlock* block = block_of(node);
+        if (block == nullptr) {
+          return Walk::BadTree;
+        }
+        if (shallowest_mm > geometry::kSurfaceTolerance_mm) {  // false for NaN
+          visit = visit_deep(settled_cover, *block);
+        } else {
+          bind_to(*block);
+          visit = visit_region_leaf(settled_cover, leaf);
+        }
+      } else if (shallowest_mm > geometry::kSurfaceTolerance_mm) {
+        visit = visit_deep_run(index, settled_cover);
+      } else {
+        if (count + 2 > pending.size()) {
+          return Walk::BadTree;
+        }
+        pending[count++] = node.right_child;
+        pending[count++] = index + 1;
+      }
+      if (visit != LeafVisit::Continue) {
+        return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
+      }
+    }
+    return Walk::Finished;
   };
   while (size > 0) {
-    const Pending pending = stack[--size];
-    const std::uint32_t index = pending.index;
-    if (index >= part.node_count()) {
+    const std::uint32_t index = stack[--size];
+    if (index >= part.node_count() || budget-- == 0) {
       return Walk::BadTree;
     }
     const tables::BvhNode& node = part.nodes[index];
@@ -207,88 +296,45 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     }
     const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
     const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
-    const bool settled = pending.settled != geometry::BoxCover::Mixed;
-    cover.cover = geometry::BoxCover::Mixed;
-    double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
-    if (settled) {
-      // Most nodes under a settled one are told shallow, or between the thresholds (a node to walk
-      // into), without region_depth_range's sqrts: the same answers (UprightDepthSpan).
-      if (!span_of || span_of->region() != pending.region) {
-        span_of.emplace(tool, pending.region, pose.tip_mm, 0.5 * geometry::kSurfaceTolerance_mm,
-                        geometry::kSurfaceTolerance_mm);
-      }
-      const geometry::DepthSpan span = (*span_of)(low, high);
-      if (span == geometry::DepthSpan::Shallower) {
-        continue;
-      }
-      if (span == geometry::DepthSpan::Between && node.point_count == 0) {
-        if (!push_children(index, node, pending)) {
-          return Walk::BadTree;
-        }
-        continue;
-      }
-      cover.cover = pending.settled;
-      cover.region = pending.region;
-      if (span == geometry::DepthSpan::Between) {
-        // A leaf not wholly deep: its bound only asks whether one of its points may be the
-        // deepest, and one no less than the range's gives the same answer.
-        cover.deepest_bound_mm = span_of->deepest_bound(low, high);
-      } else {
-        const geometry::DepthRange range =
-            geometry::region_depth_range(tool, pending.region, geometry::upright_meridian_box(pose.tip_mm, low, high));
-        if (shallower_than_penetration(range.deepest_mm)) {
-          continue;
-        }
-        cover.deepest_bound_mm = range.deepest_mm;
-        shallowest_mm = range.shallowest_mm;
-      }
-    } else if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
+    if (upright && !geometry::upright_box_may_touch(tool, pose.tip_mm, low, high, 0.0)) {
       continue;
     }
+    double shallowest_mm = -1.0;  // of a box in one region: no point is shallower (where known; NaN from a damaged surface)
     if (node.point_count > 0) {
-      if (node.point_count > tables::kMaxLeafPoints || node.first_point > part.point_count() ||
-          node.point_count > part.point_count() - node.first_point || node.leaf >= part.leaf_count() ||
-          part.leaves[node.leaf].first_point != node.first_point ||
-          part.leaves[node.leaf].point_count != node.point_count) {
-        return Walk::BadTree;  // a leaf the loader would have refused
+      const tables::LeafBlock* block = block_of(node);
+      if (block == nullptr) {
+        return Walk::BadTree;
       }
-      const tables::LeafBlock& block = part.leaves[node.leaf];
       if (upright) {
-        if (!settled) {
-          const geometry::MeridianBox box = geometry::upright_meridian_box(pose.tip_mm, low, high);
-          cover = geometry::classify_meridian_box(tool, box);
-          if (cover.cover == geometry::BoxCover::Outside ||
-              (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
-               shallower_than_penetration(cover.deepest_bound_mm))) {
-            continue;
-          }
-          if (wanted == Wanted::Penetrating &&
-              (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside)) {
-            shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
-          }
+        const geometry::MeridianBox box = geometry::upright_meridian_box(pose.tip_mm, low, high);
+        cover = geometry::classify_meridian_box(tool, box);
+        if (cover.cover == geometry::BoxCover::Outside ||
+            (wanted == Wanted::Penetrating && cover.cover != geometry::BoxCover::Mixed &&
+             shallower_than_penetration(cover.deepest_bound_mm))) {
+          continue;
         }
+        if (wanted == Wanted::Penetrating &&
+            (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside)) {
+          shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
+        }
+        LeafVisit visit = LeafVisit::Continue;
         if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {  // false for NaN
-          const LeafVisit visit = visit_deep(cover, block);
-          if (visit == LeafVisit::Continue) {
-            continue;
+          visit = visit_deep(cover, *block);
+        } else {
+          bind_to(*block);
+          if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
+              cover.cover == geometry::BoxCover::SplitAtZ) {
+            visit = visit_region_leaf(cover, leaf);
+          } else {
+            load_lanes(leaf);
+            if (!mixed_leaf_contacts(tool, leaf)) {
+              return Walk::BadTree;
+            }
+            visit = visit_leaf(leaf) ? LeafVisit::Continue : LeafVisit::Stop;
           }
+        }
+        if (visit != LeafVisit::Continue) {
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
-        }
-        bind_to(block);
-        if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside ||
-            cover.cover == geometry::BoxCover::SplitAtZ) {
-          const LeafVisit visit = visit_region_leaf(cover, leaf);
-          if (visit == LeafVisit::Continue) {
-            continue;
-          }
-          return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
-        }
-        load_lanes(leaf);
-        if (!mixed_leaf_contacts(tool, leaf)) {
-          return Walk::BadTree;
-        }
-        if (!visit_leaf(leaf)) {
-          return Walk::Stopped;
         }
         continue;
       }
@@ -299,14 +345,13 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         if (result.contact == geometry::PointContact::BadTree) {
           return Walk::BadTree;
         }
-        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result, block)) {
+        if (result.contact != geometry::PointContact::Outside && !visit_point(i, result, *block)) {
           return Walk::Stopped;
         }
       }
       continue;
     }
-    Pending child{0, pending.settled, pending.region};
-    if (upright && wanted == Wanted::Penetrating && !settled) {
+    if (upright && wanted == Wanted::Penetrating) {
       const geometry::MeridianBox box = geometry::upright_meridian_box(pose.tip_mm, low, high);
       cover = geometry::classify_meridian_box(tool, box);
       if (cover.cover == geometry::BoxCover::Outside ||
@@ -314,33 +359,22 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         continue;  // as each of its leaves would be
       }
       if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
-        child = {0, cover.cover, cover.region};
-        shallowest_mm = geometry::region_depth_range(tool, cover.region, box).shallowest_mm;
-      }
-    }
-    if (wanted == Wanted::Penetrating && shallowest_mm > geometry::kSurfaceTolerance_mm) {
-      // Every point below is deep: each leaf of the subtree (a run of leaf blocks, numbered in the
-      // walk's order) goes to visit_deep_leaf in that order, with no box below this one looked at.
-      LeafRun run{};
-      if (!leaves_below(part, index, run)) {
-        return Walk::BadTree;
-      }
-      for (std::uint32_t leaf_index = run.first; leaf_index <= run.last; ++leaf_index) {
-        const tables::LeafBlock& block = part.leaves[leaf_index];
-        if (block.point_count == 0 || block.point_count > tables::kMaxLeafPoints ||
-            block.first_point > part.point_count() || block.point_count > part.point_count() - block.first_point) {
-          return Walk::BadTree;  // a block the loader would have refused
+        // Every point below is deep, or the subtree is settled in the region.
+        const Walk walk = geometry::region_depth_range(tool, cover.region, box).shallowest_mm >
+                                  geometry::kSurfaceTolerance_mm  // false for NaN
+                              ? (visit_deep_run(index, cover) == LeafVisit::Continue ? Walk::Finished : Walk::BadTree)
+                              : walk_settled(index, node, cover.cover, cover.region);
+        if (walk != Walk::Finished) {
+          return walk;
         }
-        const LeafVisit visit = visit_deep(cover, block);  // with the subtree's bound: its own box is not looked at
-        if (visit != LeafVisit::Continue) {
-          return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
-        }
+        continue;
       }
-      continue;
     }
-    if (!push_children(index, node, child)) {
-      return Walk::BadTree;
+    if (size + 2 > stack.size()) {
+      return Walk::BadTree;  // deeper than the loader allows: the tables were not loaded by it
     }
+    stack[size++] = node.right_child;
+    stack[size++] = index + 1;
   }
   return Walk::Finished;
 }
