@@ -15,13 +15,6 @@ constexpr std::array<double, kKdopSlabCount> kSlabDirectionLength = {1.0, 1.0, 1
 
 }  // namespace
 
-std::array<double, kKdopSlabCount> kdop_projections(const Eigen::Vector3d& point_mm) {
-  const double x = point_mm.x();
-  const double y = point_mm.y();
-  const double z = point_mm.z();
-  return {x, y, z, x + y + z, x - y + z, x + y - z, x - y - z};
-}
-
 Kdop14 Kdop14::empty() {
   Kdop14 volume{};
   volume.min.fill(std::numeric_limits<double>::infinity());

@@ -24,8 +24,14 @@ inline constexpr std::array<std::array<double, 3>, kKdopSlabCount> kKdopSlabDire
     {1.0, -1.0, -1.0},
 }};
 
-// Projections of a point onto the seven slab directions (exact sums, no multiplications).
-[[nodiscard]] std::array<double, kKdopSlabCount> kdop_projections(const Eigen::Vector3d& point_mm);
+// Projections of a point onto the seven slab directions (exact sums, no multiplications). Inline:
+// the query's tool bound takes six at every query.
+[[nodiscard]] inline std::array<double, kKdopSlabCount> kdop_projections(const Eigen::Vector3d& point_mm) {
+  const double x = point_mm.x();
+  const double y = point_mm.y();
+  const double z = point_mm.z();
+  return {x, y, z, x + y + z, x - y + z, x + y - z, x - y - z};
+}
 
 // The convex polytope { p : min[i] <= d_i . p <= max[i] for all seven directions d_i }.
 // Plain data with no invariants beyond min <= max for a non-empty volume, so it can be stored in

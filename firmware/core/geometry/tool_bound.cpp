@@ -23,13 +23,18 @@ void add_cylinder(Kdop14& volume, const Eigen::Vector3d& start_mm, const Eigen::
   const auto start = kdop_projections(start_mm);
   const auto end = kdop_projections(end_mm);
   const auto axis = kdop_projections(unit_axis);
-  const bool upright = unit_axis == Eigen::Vector3d::UnitZ();
+  std::array<double, kKdopSlabCount> reach;  // per unit of radius
+  if (unit_axis == Eigen::Vector3d::UnitZ()) {
+    reach = kUprightReach;
+  } else {
+    for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+      const double length_squared = slab < 3 ? 1.0 : 3.0;
+      reach[slab] = std::sqrt(std::max(0.0, length_squared - axis[slab] * axis[slab]));
+    }
+  }
   for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-    const double length_squared = slab < 3 ? 1.0 : 3.0;
-    const double reach = radius_mm * (upright ? kUprightReach[slab]
-                                              : std::sqrt(std::max(0.0, length_squared - axis[slab] * axis[slab])));
-    volume.min[slab] = std::min(volume.min[slab], std::min(start[slab], end[slab]) - reach);
-    volume.max[slab] = std::max(volume.max[slab], std::max(start[slab], end[slab]) + reach);
+    volume.min[slab] = std::min(volume.min[slab], std::min(start[slab], end[slab]) - radius_mm * reach[slab]);
+    volume.max[slab] = std::max(volume.max[slab], std::max(start[slab], end[slab]) + radius_mm * reach[slab]);
   }
 }
 
