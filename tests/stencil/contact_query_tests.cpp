@@ -117,8 +117,8 @@ TEST(ContactQuery, APoseThatIsNotANumberIsRefusedNotAnswered) {
 
 // Tables that did not come through the loader: a node whose right child is itself. Wherever the
 // walk meets it, in the tree's mixed nodes or in a subtree settled in one region, it ends in a bad
-// tree (its stack, as deep as the loader allows trees to be, fills) rather than looping or writing
-// past its stack; where the walk never opens it, the answer is the sound tree's.
+// tree (the walk's budget of the node count runs out: its stack only cycles) rather than looping;
+// where the walk never opens it, the answer is the sound tree's.
 TEST(ContactQuery, ANodeThatIsItsOwnChildEndsTheWalkAsABadTreeWhereverTheWalkMeetsIt) {
   const ToolPose pose = upright_at(25.3, 12.1, kTop_mm - 0.2);
   const ContactResult sound = query_contacts(part, pose, parameters);
@@ -143,11 +143,38 @@ TEST(ContactQuery, ANodeThatIsItsOwnChildEndsTheWalkAsABadTreeWhereverTheWalkMee
     } else {
       CHECK(result.status == QueryStatus::Ok);
       CHECK(result.force_n == sound.force_n);
+      CHECK(result.torque_nmm == sound.torque_nmm);
       LONGS_EQUAL(sound.penetrating_points, result.penetrating_points);
+      DOUBLES_EQUAL(sound.max_depth_mm, result.max_depth_mm, 0.0);
+      LONGS_EQUAL(sound.deepest_point, result.deepest_point);
     }
   }
   // The root, the nodes down to the contact, and the settled subtrees' nodes walked into.
   CHECK(bad > 5);
+}
+
+// Legality is the query's answer: illegal exactly where a point penetrates, and never a fault on
+// sound tables, however deep the plunge. A wide flat end deep in the dense part's tree meets mixed
+// nodes wholly deep in one region, whose leaves the walk takes as a run: legality stops at the
+// first of them (an illegal pose, not a bad tree).
+TEST(ContactQuery, LegalityIsIllegalExactlyWhereThePlungePenetratesNeverAFault) {
+  const tablegen::TableBytes dense_bytes = table_at_spacing("flat:d=8", 0.04);
+  tables::PartTables dense{};
+  CHECK(tables::load_tables({dense_bytes.data(), dense_bytes.size()}, dense).ok);
+  int illegal = 0;
+  for (const double x : {17.0, 19.2, 23.0, 25.0, 28.5, 31.0}) {
+    for (const double y : {9.0, 12.5, 14.3, 16.0}) {
+      for (const double z : {kTop_mm + 0.001, kTop_mm - 0.3, 2.0, -1.31}) {
+        const ToolPose pose = upright_at(x, y, z);
+        const ContactResult result = query_contacts(dense, pose, parameters);
+        CHECK(result.status == QueryStatus::Ok);
+        const Legality legality = check_legal(dense, pose);
+        CHECK(legality == (result.penetrating_points > 0 ? Legality::Illegal : Legality::Legal));
+        illegal += legality == Legality::Illegal ? 1 : 0;
+      }
+    }
+  }
+  CHECK(illegal > 40);
 }
 
 TEST(ContactQuery, TouchedTrianglesAreThoseNearTheToolOnly) {

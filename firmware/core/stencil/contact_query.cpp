@@ -67,7 +67,9 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
 // penetrating points are wanted, a leaf whose box lies wholly deeper than the tolerance in one
 // region, and every leaf under a node whose box does, goes first to visit_deep_leaf (below).
-// Iterative, with a fixed stack as deep as the loader allows trees to be.
+// Iterative: two fixed stacks as deep as the loader allows trees to be (one for the nodes not
+// settled by an ancestor, one for a settled subtree's), and a budget of the tree's node count
+// for the nodes and the leaves taken whole, so tables the loader would refuse cannot make it loop.
 enum class Wanted : std::uint8_t {
   Penetrating,  // only points deeper than the tolerance matter (force, legality)
   InTool,       // points on the surface matter too (touched triangles)
@@ -142,9 +144,10 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   std::array<std::uint32_t, tables::kMaxTreeDepth + 1> stack;  // nodes not settled by an ancestor
   std::size_t size = 0;
   stack[size++] = 0;
-  // Nodes the walk may still take: each node of a tree is taken once at most, so tables with a
-  // link back up the tree (which the loader refuses) end the walk as a bad tree instead of
-  // looping, and the two loops below are bounded by the node count.
+  // Nodes the walk may still take, popped or as leaves of a wholly deep run: in a tree each node is
+  // taken once at most, so tables with a link back up the tree (which the loader refuses) end the
+  // walk as a bad tree instead of looping, and all the walk's loops together take at most the node
+  // count of steps.
   std::uint32_t budget = part.node_count();
   LeafContacts leaf;
   // The tip split for the lanes, once a walk, and only when a leaf is met (a query in free space
@@ -184,9 +187,10 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   // looked at: each with the subtree's cover and bound.
   const auto visit_deep_run = [&](std::uint32_t index, const geometry::BoxClassification& deep_cover) {
     LeafRun run{};
-    if (!leaves_below(part, index, run)) {
+    if (!leaves_below(part, index, run) || run.last - run.first >= budget) {
       return LeafVisit::Fault;
     }
+    budget -= run.last - run.first + 1;  // leaves the walk takes whole, each once in a sound tree
     for (std::uint32_t leaf_index = run.first; leaf_index <= run.last; ++leaf_index) {
       const tables::LeafBlock& block = part.leaves[leaf_index];
       if (block.point_count == 0 || block.point_count > tables::kMaxLeafPoints ||
@@ -217,12 +221,12 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
     const geometry::UprightDepthSpan span(tool, region, pose.tip_mm, 0.5 * geometry::kSurfaceTolerance_mm,
                                           geometry::kSurfaceTolerance_mm);
     geometry::BoxClassification settled_cover{settled, region, 0.0, 0.0, {}, {}};
-    std::array<std::uint32_t, tables::kMaxTreeDepth + 1> pending;
+    std::array<std::uint32_t, tables::kMaxTreeDepth + 1> below;  // its own stack
     std::size_t count = 0;
-    pending[count++] = root_node.right_child;
-    pending[count++] = root + 1;
+    below[count++] = root_node.right_child;
+    below[count++] = root + 1;
     while (count > 0) {
-      const std::uint32_t index = pending[--count];
+      const std::uint32_t index = below[--count];
       if (index >= part.node_count() || budget-- == 0) {
         return Walk::BadTree;
       }
@@ -237,11 +241,11 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         continue;
       }
       if (depth_span == geometry::DepthSpan::Between && node.point_count == 0) {
-        if (count + 2 > pending.size()) {
+        if (count + 2 > below.size()) {
           return Walk::BadTree;  // deeper than the loader allows
         }
-        pending[count++] = node.right_child;
-        pending[count++] = index + 1;
+        below[count++] = node.right_child;
+        below[count++] = index + 1;
         continue;
       }
       double shallowest_mm = -1.0;  // no point is shallower (where known; NaN from a damaged surface)
@@ -273,11 +277,11 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       } else if (shallowest_mm > geometry::kSurfaceTolerance_mm) {
         visit = visit_deep_run(index, settled_cover);
       } else {
-        if (count + 2 > pending.size()) {
+        if (count + 2 > below.size()) {
           return Walk::BadTree;
         }
-        pending[count++] = node.right_child;
-        pending[count++] = index + 1;
+        below[count++] = node.right_child;
+        below[count++] = index + 1;
       }
       if (visit != LeafVisit::Continue) {
         return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
@@ -360,10 +364,15 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       }
       if (cover.cover == geometry::BoxCover::Region || cover.cover == geometry::BoxCover::RegionOrOutside) {
         // Every point below is deep, or the subtree is settled in the region.
-        const Walk walk = geometry::region_depth_range(tool, cover.region, box).shallowest_mm >
-                                  geometry::kSurfaceTolerance_mm  // false for NaN
-                              ? (visit_deep_run(index, cover) == LeafVisit::Continue ? Walk::Finished : Walk::BadTree)
-                              : walk_settled(index, node, cover.cover, cover.region);
+        if (geometry::region_depth_range(tool, cover.region, box).shallowest_mm >
+            geometry::kSurfaceTolerance_mm) {  // false for NaN
+          const LeafVisit visit = visit_deep_run(index, cover);
+          if (visit != LeafVisit::Continue) {
+            return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
+          }
+          continue;
+        }
+        const Walk walk = walk_settled(index, node, cover.cover, cover.region);
         if (walk != Walk::Finished) {
           return walk;
         }

@@ -7,6 +7,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Geometry>
+
 #if defined(__AVX2__)
 #include <immintrin.h>
 #endif
