@@ -6,15 +6,6 @@
 #include <limits>
 
 namespace stencil::geometry {
-namespace {
-
-constexpr double kSqrt3 = 1.7320508075688772;
-
-// Length of each slab direction: the first three are unit axes, the diagonals have length sqrt(3).
-constexpr std::array<double, kKdopSlabCount> kSlabDirectionLength = {1.0, 1.0, 1.0, kSqrt3, kSqrt3, kSqrt3, kSqrt3};
-
-}  // namespace
-
 Kdop14 Kdop14::empty() {
   Kdop14 volume{};
   volume.min.fill(std::numeric_limits<double>::infinity());
@@ -47,10 +38,10 @@ void Kdop14::merge(const Kdop14& other) {
 }
 
 Kdop14 Kdop14::enlarged(double margin_mm) const {
-  Kdop14 volume = *this;
+  Kdop14 volume;
   for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-    volume.min[slab] -= margin_mm * kSlabDirectionLength[slab];
-    volume.max[slab] += margin_mm * kSlabDirectionLength[slab];
+    volume.min[slab] = min[slab] - margin_mm * kKdopSlabLength[slab];
+    volume.max[slab] = max[slab] + margin_mm * kKdopSlabLength[slab];
   }
   return volume;
 }
@@ -58,7 +49,7 @@ Kdop14 Kdop14::enlarged(double margin_mm) const {
 bool Kdop14::contains(const Eigen::Vector3d& point_mm, double tolerance_mm) const {
   const auto projection = kdop_projections(point_mm);
   for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-    const double widen = tolerance_mm * kSlabDirectionLength[slab];
+    const double widen = tolerance_mm * kKdopSlabLength[slab];
     if (projection[slab] < min[slab] - widen || projection[slab] > max[slab] + widen) {
       return false;
     }

@@ -24,6 +24,10 @@ inline constexpr std::array<std::array<double, 3>, kKdopSlabCount> kKdopSlabDire
     {1.0, -1.0, -1.0},
 }};
 
+// Length of each slab direction: the first three are unit axes, the diagonals have length sqrt(3).
+inline constexpr std::array<double, kKdopSlabCount> kKdopSlabLength = {
+    1.0, 1.0, 1.0, 1.7320508075688772, 1.7320508075688772, 1.7320508075688772, 1.7320508075688772};
+
 // Projections of a point onto the seven slab directions (exact sums, no multiplications). Inline:
 // the query's tool bound takes six at every query.
 [[nodiscard]] inline std::array<double, kKdopSlabCount> kdop_projections(const Eigen::Vector3d& point_mm) {
