@@ -4,6 +4,7 @@
 // beside the engine of commit 1f546f3 (rows "previous"), with each query's instruction count from
 // callgrind, so that a speed-up is a ratio from one run and a count no machine's noise moves.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -83,26 +84,53 @@ struct Timing {
   double p999_us;
   double max_us;
   std::size_t samples;
+  std::size_t batch;  // runs of the work per sample (each sample their mean)
 };
 
+// Work this short is timed in batches: a read of the clock costs tens of nanoseconds here and
+// comes in steps of about ten, as long as a query in free space, so one run between two reads
+// times the clock more than the work.
+constexpr double kShortestTimedAlone_us = 1.0;
+constexpr double kBatchLength_us = 2.0;
+
+// Times `work` up to `iterations` samples or `budget_s` seconds (at least 11 samples), and gives
+// their median, 99.9th percentile and maximum in microseconds. Work under kShortestTimedAlone_us
+// (by the median of eleven runs timed alone) is run back to back in batches of about
+// kBatchLength_us, each sample the batch's mean: the percentiles are then of batch means, which
+// smooth a single run's tail.
 template <typename Work>
 Timing measure(Work&& work, std::size_t iterations, double budget_s) {
+  const auto time_batch = [&](std::size_t batch) {
+    const auto begin = Clock::now();
+    for (std::size_t run = 0; run < batch; ++run) {
+      work();
+    }
+    const auto end = Clock::now();
+    return std::chrono::duration<double, std::micro>(end - begin).count() / static_cast<double>(batch);
+  };
+  std::array<double, 11> alone{};
+  for (double& sample : alone) {
+    sample = time_batch(1);
+  }
+  std::nth_element(alone.begin(), alone.begin() + alone.size() / 2, alone.end());
+  const double alone_us = alone[alone.size() / 2];
+  const std::size_t batch =
+      alone_us >= kShortestTimedAlone_us
+          ? 1
+          : static_cast<std::size_t>(std::ceil(kBatchLength_us / std::max(alone_us, 0.001)));
   std::vector<double> samples;
   samples.reserve(iterations);
   const auto started = Clock::now();
   for (std::size_t i = 0; i < iterations; ++i) {
-    const auto begin = Clock::now();
-    work();
-    const auto end = Clock::now();
-    samples.push_back(std::chrono::duration<double, std::micro>(end - begin).count());
-    if (i >= 10 && std::chrono::duration<double>(end - started).count() > budget_s) {
+    samples.push_back(time_batch(batch));
+    if (i >= 10 && std::chrono::duration<double>(Clock::now() - started).count() > budget_s) {
       break;
     }
   }
   std::sort(samples.begin(), samples.end());
   const std::size_t n = samples.size();
   const std::size_t p999 = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.999 * static_cast<double>(n))) - 1);
-  return {samples[n / 2], samples[p999], samples.back(), n};
+  return {samples[n / 2], samples[p999], samples.back(), n, batch};
 }
 
 struct State {
@@ -353,13 +381,13 @@ void print_row(const Options& options, const Row& row) {
         row.count.ok ? ", \"instructions\": " + instructions + ", \"l1_misses\": " + misses : std::string();
     std::printf(
         "{\"points\": %u, \"triangles\": %u, \"state\": \"%s\", \"impl\": \"%s\", \"what\": \"%s\", "
-        "\"median_us\": %.3f, \"p999_us\": %.3f, \"max_us\": %.3f, \"samples\": %zu%s}\n",
+        "\"median_us\": %.3f, \"p999_us\": %.3f, \"max_us\": %.3f, \"samples\": %zu, \"batch\": %zu%s}\n",
         row.points, row.triangles, row.state.c_str(), row.impl.c_str(), row.what.c_str(), row.timing.median_us,
-        row.timing.p999_us, row.timing.max_us, row.timing.samples, counted.c_str());
+        row.timing.p999_us, row.timing.max_us, row.timing.samples, row.timing.batch, counted.c_str());
   } else {
-    std::printf("%9u %-12s %-12s %-8s %10.2f %10.2f %10.2f %8zu %12s %9s\n", row.points, row.state.c_str(),
+    std::printf("%9u %-12s %-12s %-8s %10.3f %10.3f %10.3f %8zu %6zu %12s %9s\n", row.points, row.state.c_str(),
                 row.impl.c_str(), row.what.c_str(), row.timing.median_us, row.timing.p999_us, row.timing.max_us,
-                row.timing.samples, instructions.c_str(), misses.c_str());
+                row.timing.samples, row.timing.batch, instructions.c_str(), misses.c_str());
   }
   std::fflush(stdout);
 }
@@ -400,7 +428,7 @@ std::vector<Row> previous_rows(const Options& options, const std::string& table,
     row.impl = "previous";
     row.what = json_field(line, "what");
     row.timing = {std::stod(json_field(line, "median_us")), std::stod(json_field(line, "p999_us")),
-                  std::stod(json_field(line, "max_us")), std::stoul(json_field(line, "samples"))};
+                  std::stod(json_field(line, "max_us")), std::stoul(json_field(line, "samples")), std::stoul(json_field(line, "batch"))};
     row.count = row.what == "query" ? count : QueryCount{};
     rows.push_back(row);
   }
@@ -541,7 +569,7 @@ void tablegen_rows(const Options& options, const std::string& scratch) {
     row.state = "-";
     row.impl = which == 0 ? "stencil" : "previous";
     row.what = "tablegen";
-    row.timing = {runs[kRounds / 2] * 1e6, runs.back() * 1e6, runs.back() * 1e6, static_cast<std::size_t>(kRounds)};
+    row.timing = {runs[kRounds / 2] * 1e6, runs.back() * 1e6, runs.back() * 1e6, static_cast<std::size_t>(kRounds), 1};
     print_row(options, row);
   }
 }
@@ -554,6 +582,9 @@ constexpr const char* kUsage =
     "face), deep contact (0.5 mm into a face) and deep in a concave corner, beside brute force and\n"
     "FCL. --large: only 1e6 points; --points N: only about N. --stencil-only: leave out brute force\n"
     "and FCL. --state free|light|deep|deep-corner: only that state (for profiling one case).\n"
+    "Times are in microseconds per run. Work under 1 us (a read of the clock costs tens of ns) is\n"
+    "timed in batches of about 2 us run back to back, each sample a batch's mean: column \"batch\"\n"
+    "gives the runs per sample (1: each run timed alone), and its p999 and max are of batch means.\n"
     "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
     "timed the same way, so the machine's own tail can be told from the code's.\n"
     "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
@@ -664,8 +695,8 @@ int main(int argc, char** argv) {
     }
   } const remove_scratch{scratch};
   if (!options.json && !options.count_queries) {
-    std::printf("%9s %-12s %-12s %-8s %10s %10s %10s %8s %12s %9s\n", "points", "state", "impl", "what", "median_us",
-                "p999_us", "max_us", "samples", "instructions", "l1_misses");
+    std::printf("%9s %-12s %-12s %-8s %10s %10s %10s %8s %6s %12s %9s\n", "points", "state", "impl", "what",
+                "median_us", "p999_us", "max_us", "samples", "batch", "instructions", "l1_misses");
   }
   int status = 0;
   const std::vector<std::size_t> sizes = options.table_path.empty() ? options.sizes : std::vector<std::size_t>{0};
