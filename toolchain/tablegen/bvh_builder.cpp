@@ -7,6 +7,8 @@
 #include <cstring>
 #include <numeric>
 #include <thread>
+#include <utility>
+#include <vector>
 
 #include "firmware/core/geometry/kdop14.hpp"
 
@@ -60,10 +62,15 @@ class TreeBuilder {
     order_groups(volume_of(middle, end), middle, end);
   }
 
+  // Kdop14::add's arithmetic, inline (the tree's build takes each point once per level).
   geometry::Kdop14 volume_of(std::uint32_t begin, std::uint32_t end) const {
     geometry::Kdop14 volume = geometry::Kdop14::empty();
     for (std::uint32_t i = begin; i < end; ++i) {
-      volume.add(to_vector(points_[tree_.order[i]]));
+      const auto projection = geometry::kdop_projections(to_vector(points_[tree_.order[i]]));
+      for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+        volume.min[slab] = std::min(volume.min[slab], projection[slab]);
+        volume.max[slab] = std::max(volume.max[slab], projection[slab]);
+      }
     }
     return volume;
   }
@@ -80,16 +87,21 @@ class TreeBuilder {
       }
     }
     const auto& direction = geometry::kKdopSlabDirections[widest];
-    const auto key = [&](std::uint32_t index) {
+    // Each point's key once, beside its index, rather than from the points at every comparison.
+    // Ties broken by index make the halves well defined; nth_element is deterministic and makes the
+    // same moves for the same comparisons, so the order is the one it gave the indices themselves.
+    std::vector<std::pair<double, std::uint32_t>> keys(end - begin);
+    for (std::uint32_t i = begin; i < end; ++i) {
+      const std::uint32_t index = tree_.order[i];
       const tables::PackedPoint& point = points_[index];
       const double projection = direction[0] * double{point.x_mm} + direction[1] * double{point.y_mm} +
                                 direction[2] * double{point.z_mm};
-      return std::make_pair(projection, index);
-    };
-    // Ties broken by index make the halves well defined; nth_element is deterministic, so the same
-    // build of the generator gives the same order every time.
-    std::nth_element(tree_.order.begin() + begin, tree_.order.begin() + middle, tree_.order.begin() + end,
-                     [&](std::uint32_t a, std::uint32_t b) { return key(a) < key(b); });
+      keys[i - begin] = {projection, index};
+    }
+    std::nth_element(keys.begin(), keys.begin() + (middle - begin), keys.end());
+    for (std::uint32_t i = begin; i < end; ++i) {
+      tree_.order[i] = keys[i - begin].second;
+    }
     return middle;
   }
 
