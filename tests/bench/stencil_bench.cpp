@@ -88,36 +88,44 @@ struct Timing {
 };
 
 // Work this short is timed in batches: a read of the clock costs tens of nanoseconds here and
-// comes in steps of about ten, as long as a query in free space, so one run between two reads
+// comes in steps of about 10 ns, as long as a query in free space, so one run between two reads
 // times the clock more than the work.
 constexpr double kShortestTimedAlone_us = 1.0;
 constexpr double kBatchLength_us = 2.0;
+constexpr std::size_t kCalibrationBatch = 100;
 
 // Times `work` up to `iterations` samples or `budget_s` seconds (at least 11 samples), and gives
-// their median, 99.9th percentile and maximum in microseconds. Work under kShortestTimedAlone_us
-// (by the median of eleven runs timed alone) is run back to back in batches of about
-// kBatchLength_us, each sample the batch's mean: the percentiles are then of batch means, which
-// smooth a single run's tail.
+// their median, 99.9th percentile and maximum in microseconds per run. Work under
+// kShortestTimedAlone_us (by the median of eleven runs timed alone) is run back to back in batches
+// of about kBatchLength_us (sized from eleven batches of kCalibrationBatch runs, whose clock reads
+// are a small part), each sample the batch's mean: the percentiles are then of batch means, which
+// smooth a single run's tail. batch > 0 takes that many runs per sample instead (a baseline timed
+// as its cycle was).
 template <typename Work>
-Timing measure(Work&& work, std::size_t iterations, double budget_s) {
-  const auto time_batch = [&](std::size_t batch) {
+Timing measure(Work&& work, std::size_t iterations, double budget_s, std::size_t batch = 0) {
+  const auto time_batch = [&](std::size_t runs) {
     const auto begin = Clock::now();
-    for (std::size_t run = 0; run < batch; ++run) {
+    for (std::size_t run = 0; run < runs; ++run) {
       work();
     }
     const auto end = Clock::now();
-    return std::chrono::duration<double, std::micro>(end - begin).count() / static_cast<double>(batch);
+    return std::chrono::duration<double, std::micro>(end - begin).count() / static_cast<double>(runs);
   };
-  std::array<double, 11> alone{};
-  for (double& sample : alone) {
-    sample = time_batch(1);
+  const auto median_of_eleven = [&](std::size_t runs) {
+    std::array<double, 11> means{};
+    for (double& mean : means) {
+      mean = time_batch(runs);
+    }
+    std::nth_element(means.begin(), means.begin() + means.size() / 2, means.end());
+    return means[means.size() / 2];
+  };
+  if (batch == 0) {
+    batch = 1;
+    if (median_of_eleven(1) < kShortestTimedAlone_us) {
+      const double run_us = median_of_eleven(kCalibrationBatch);
+      batch = static_cast<std::size_t>(std::ceil(kBatchLength_us / std::max(run_us, 0.001)));
+    }
   }
-  std::nth_element(alone.begin(), alone.begin() + alone.size() / 2, alone.end());
-  const double alone_us = alone[alone.size() / 2];
-  const std::size_t batch =
-      alone_us >= kShortestTimedAlone_us
-          ? 1
-          : static_cast<std::size_t>(std::ceil(kBatchLength_us / std::max(alone_us, 0.001)));
   std::vector<double> samples;
   samples.reserve(iterations);
   const auto started = Clock::now();
@@ -153,10 +161,10 @@ std::size_t brute_force(const tables::PartTables& part, const Eigen::Vector3d& t
 volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
 
 // The machine's own tail at a given length of work: a fixed chain of dependent arithmetic, as long
-// as `median_us`, timed the same way. On a shared or virtual machine the 99.9th percentile of any
+// as `median_us`, timed the same way (`batch` runs to a sample, as its cycle). On a shared or virtual machine the 99.9th percentile of any
 // work of tens of microseconds is inflated by interrupts and by the host taking the CPU away; this
 // row, in the same run, shows how much of a measured tail is the machine's rather than the code's.
-Timing baseline_of_length(double median_us) {
+Timing baseline_of_length(double median_us, std::size_t batch) {
   const auto chain = [](std::size_t steps) {
     double value = sink;
     for (std::size_t i = 0; i < steps; ++i) {
@@ -169,7 +177,7 @@ Timing baseline_of_length(double median_us) {
     const Timing t = measure([&] { chain(steps); }, 200, 0.5);
     steps = std::max<std::size_t>(1, static_cast<std::size_t>(static_cast<double>(steps) * median_us / t.median_us));
   }
-  return measure([&] { chain(steps); }, 5000, 2.0);
+  return measure([&] { chain(steps); }, 5000, 2.0, batch);
 }
 
 
@@ -428,7 +436,10 @@ std::vector<Row> previous_rows(const Options& options, const std::string& table,
     row.impl = "previous";
     row.what = json_field(line, "what");
     row.timing = {std::stod(json_field(line, "median_us")), std::stod(json_field(line, "p999_us")),
-                  std::stod(json_field(line, "max_us")), std::stoul(json_field(line, "samples")), std::stoul(json_field(line, "batch"))};
+                  std::stod(json_field(line, "max_us")), std::stoul(json_field(line, "samples")), 1};
+    // A bench built before batches had none: each run timed alone.
+    const std::string batch = json_field(line, "batch");
+    row.timing.batch = batch.empty() ? 1 : std::stoul(batch);
     row.count = row.what == "query" ? count : QueryCount{};
     rows.push_back(row);
   }
@@ -470,7 +481,7 @@ void state_rows(const Options& options, const tables::PartTables& part, const be
       },
       5000, 2.0);
   emit("stencil", "cycle", cycle, {});
-  emit("baseline", "cycle", baseline_of_length(cycle.median_us), {});
+  emit("baseline", "cycle", baseline_of_length(cycle.median_us, cycle.batch), {});
 #if !defined(STENCIL_BENCH_PREVIOUS)
   // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
   // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
@@ -513,7 +524,7 @@ void state_rows(const Options& options, const tables::PartTables& part, const be
       },
       5000, 2.0);
   emit("stencil+feel", "cycle", felt, {});
-  emit("baseline", "cycle", baseline_of_length(felt.median_us), {});
+  emit("baseline", "cycle", baseline_of_length(felt.median_us, felt.batch), {});
 #endif
   if (fcl == nullptr) {
     return;
@@ -584,7 +595,7 @@ constexpr const char* kUsage =
     "and FCL. --state free|light|deep|deep-corner: only that state (for profiling one case).\n"
     "Times are in microseconds per run. Work under 1 us (a read of the clock costs tens of ns) is\n"
     "timed in batches of about 2 us run back to back, each sample a batch's mean: column \"batch\"\n"
-    "gives the runs per sample (1: each run timed alone), and its p999 and max are of batch means.\n"
+    "gives the runs per sample (1: each run timed alone); such a row's p999 and max are of batch means.\n"
     "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
     "timed the same way, so the machine's own tail can be told from the code's.\n"
     "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"

@@ -17,9 +17,6 @@ namespace {
 
 using geometry::kKdopSlabCount;
 
-constexpr std::array<double, kKdopSlabCount> kSlabLength = {1.0, 1.0, 1.0, 1.7320508075688772, 1.7320508075688772,
-                                                            1.7320508075688772, 1.7320508075688772};
-
 Eigen::Vector3d to_vector(const tables::PackedPoint& point) { return {point.x_mm, point.y_mm, point.z_mm}; }
 
 class TreeBuilder {
@@ -62,15 +59,10 @@ class TreeBuilder {
     order_groups(volume_of(middle, end), middle, end);
   }
 
-  // Kdop14::add's arithmetic, inline (the tree's build takes each point once per level).
   geometry::Kdop14 volume_of(std::uint32_t begin, std::uint32_t end) const {
     geometry::Kdop14 volume = geometry::Kdop14::empty();
     for (std::uint32_t i = begin; i < end; ++i) {
-      const auto projection = geometry::kdop_projections(to_vector(points_[tree_.order[i]]));
-      for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-        volume.min[slab] = std::min(volume.min[slab], projection[slab]);
-        volume.max[slab] = std::max(volume.max[slab], projection[slab]);
-      }
+      volume.add(to_vector(points_[tree_.order[i]]));
     }
     return volume;
   }
@@ -80,16 +72,16 @@ class TreeBuilder {
     std::size_t widest = 0;
     double widest_extent = -1.0;
     for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-      const double extent = (volume.max[slab] - volume.min[slab]) / kSlabLength[slab];
+      const double extent = (volume.max[slab] - volume.min[slab]) / geometry::kKdopSlabLength[slab];
       if (extent > widest_extent) {
         widest_extent = extent;
         widest = slab;
       }
     }
     const auto& direction = geometry::kKdopSlabDirections[widest];
-    // Each point's key once, beside its index, rather than from the points at every comparison.
-    // Ties broken by index make the halves well defined; nth_element is deterministic and makes the
-    // same moves for the same comparisons, so the order is the one it gave the indices themselves.
+    // Each point's key computed once and kept beside its index: nth_element compares each element
+    // many times. Ties broken by index make the halves well defined; nth_element is deterministic,
+    // so the same build of the generator gives the same order every time.
     std::vector<std::pair<double, std::uint32_t>> keys(end - begin);
     for (std::uint32_t i = begin; i < end; ++i) {
       const std::uint32_t index = tree_.order[i];

@@ -2,10 +2,10 @@
 #include "firmware/core/geometry/kdop14.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <limits>
 
 namespace stencil::geometry {
+
 Kdop14 Kdop14::empty() {
   Kdop14 volume{};
   volume.min.fill(std::numeric_limits<double>::infinity());
@@ -20,14 +20,6 @@ bool Kdop14::is_empty() const {
     }
   }
   return false;
-}
-
-void Kdop14::add(const Eigen::Vector3d& point_mm) {
-  const auto projection = kdop_projections(point_mm);
-  for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
-    min[slab] = std::min(min[slab], projection[slab]);
-    max[slab] = std::max(max[slab], projection[slab]);
-  }
 }
 
 void Kdop14::merge(const Kdop14& other) {

@@ -1,6 +1,7 @@
 // The 14-DOP bounding volume: seven fixed slab directions, an interval along each.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <span>
@@ -29,7 +30,7 @@ inline constexpr std::array<double, kKdopSlabCount> kKdopSlabLength = {
     1.0, 1.0, 1.0, 1.7320508075688772, 1.7320508075688772, 1.7320508075688772, 1.7320508075688772};
 
 // Projections of a point onto the seven slab directions (exact sums, no multiplications). Inline:
-// the query's tool bound takes six at every query.
+// the query's tool bound takes three at every query, the table generator one per point and level.
 [[nodiscard]] inline std::array<double, kKdopSlabCount> kdop_projections(const Eigen::Vector3d& point_mm) {
   const double x = point_mm.x();
   const double y = point_mm.y();
@@ -47,8 +48,15 @@ struct Kdop14 {
   [[nodiscard]] static Kdop14 empty();
   [[nodiscard]] bool is_empty() const;
 
-  // Grows the volume to include a point.
-  void add(const Eigen::Vector3d& point_mm);
+  // Grows the volume to include a point. Inline: the table generator's tree takes every point once
+  // per level.
+  void add(const Eigen::Vector3d& point_mm) {
+    const auto projection = kdop_projections(point_mm);
+    for (std::size_t slab = 0; slab < kKdopSlabCount; ++slab) {
+      min[slab] = std::min(min[slab], projection[slab]);
+      max[slab] = std::max(max[slab], projection[slab]);
+    }
+  }
   // Grows the volume to include another volume.
   void merge(const Kdop14& other);
   // The volume grown by margin_mm in every direction (each slab by margin_mm times its length),

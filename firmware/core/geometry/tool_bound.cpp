@@ -34,10 +34,10 @@ std::array<double, kKdopSlabCount> disc_reach(const Eigen::Vector3d& unit_axis) 
 
 }  // namespace
 
-// Each bound is computed in registers and stored once. Building the volume up in memory (an empty
-// one grown by each cylinder, then enlarged) made every step load what the one before had just
-// stored, in pieces of other widths, which the CPU cannot forward from its store buffer: a chain
-// of stalls that took a query in free space longer than its work did.
+// Both cylinders and the margin in one pass, each bound written once. Not built up in a volume (an
+// empty one grown by each cylinder, then enlarged): each step would reload what the one before had
+// just stored, in pieces of another width, which the CPU cannot forward from its store buffer, and
+// those stalls took a query in free space longer than its work.
 Kdop14 tool_kdop(const ToolEnvelope& envelope, const Eigen::Vector3d& tip_mm, const Eigen::Vector3d& unit_axis) {
   const auto tip = kdop_projections(tip_mm);
   const auto flute_top = kdop_projections(tip_mm + envelope.flute_length_mm * unit_axis);
