@@ -161,9 +161,10 @@ std::size_t brute_force(const tables::PartTables& part, const Eigen::Vector3d& t
 volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
 
 // The machine's own tail at a given length of work: a fixed chain of dependent arithmetic, as long
-// as `median_us`, timed the same way (`batch` runs to a sample, as its cycle). On a shared or virtual machine the 99.9th percentile of any
-// work of tens of microseconds is inflated by interrupts and by the host taking the CPU away; this
-// row, in the same run, shows how much of a measured tail is the machine's rather than the code's.
+// as `median_us`, timed the same way (`batch` runs to a sample, as its cycle). On a shared or
+// virtual machine the 99.9th percentile of any work of tens of microseconds is inflated by
+// interrupts and by the host taking the CPU away; this row, in the same run, shows how much of a
+// measured tail is the machine's rather than the code's.
 Timing baseline_of_length(double median_us, std::size_t batch) {
   const auto chain = [](std::size_t steps) {
     double value = sink;
