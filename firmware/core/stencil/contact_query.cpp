@@ -309,6 +309,21 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   // deep corner's boxes met the plane of a ball's centre.
   const auto walk_split = [&](std::uint32_t root, const tables::BvhNode& root_node,
                               const geometry::BoxClassification& split) {
+    // Each settled side's depths: a box shallower on a side has no penetrating point there (none
+    // of its points reaching that side's region is as deep as half the tolerance, the others are
+    // outside the tool), so that side is taken as outside the tool for it: the same lanes' verdicts
+    // (depth 0 either way) and forces (0), without that surface's numbers. A box shallower on both
+    // is skipped, with everything under it.
+    const auto span_of = [&](const geometry::BoxPart& side) {
+      return side.cover == geometry::BoxCover::Outside
+                 ? std::nullopt
+                 : std::optional<geometry::UprightDepthSpan>(std::in_place, tool, side.region, pose.tip_mm,
+                                                             0.5 * geometry::kSurfaceTolerance_mm,
+                                                             geometry::kSurfaceTolerance_mm);
+    };
+    const std::optional<geometry::UprightDepthSpan> below_span = span_of(split.below);
+    const std::optional<geometry::UprightDepthSpan> above_span = span_of(split.above);
+    geometry::BoxClassification leaf_cover = split;
     std::array<std::uint32_t, tables::kMaxTreeDepth + 1> across;  // its own stack
     std::size_t count = 0;
     across[count++] = root_node.right_child;
@@ -344,13 +359,22 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
       if (!overlaps_node(volume, node)) {
         continue;
       }
+      const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
+      const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
+      const bool below_shallow = !below_span || (*below_span)(low, high) == geometry::DepthSpan::Shallower;
+      const bool above_shallow = !above_span || (*above_span)(low, high) == geometry::DepthSpan::Shallower;
+      if (below_shallow && above_shallow) {
+        continue;
+      }
       if (node.point_count > 0) {
         const tables::LeafBlock* block = block_of(node);
         if (block == nullptr) {
           return Walk::BadTree;
         }
+        leaf_cover.below = below_shallow ? geometry::BoxPart{geometry::BoxCover::Outside, 0, 0.0} : split.below;
+        leaf_cover.above = above_shallow ? geometry::BoxPart{geometry::BoxCover::Outside, 0, 0.0} : split.above;
         bind_to(*block);
-        const LeafVisit visit = visit_region_leaf(split, leaf);
+        const LeafVisit visit = visit_region_leaf(leaf_cover, leaf);
         if (visit != LeafVisit::Continue) {
           return visit == LeafVisit::Stop ? Walk::Stopped : Walk::BadTree;
         }
