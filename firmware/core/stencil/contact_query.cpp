@@ -66,7 +66,9 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 // visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
 // block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
 // penetrating points are wanted, a leaf whose box lies wholly deeper than the tolerance in one
-// region, and every leaf under a node whose box does, goes first to visit_deep_leaf (below).
+// region, and every leaf under a node whose box does, goes first to visit_deep_leaf (below); a node
+// whose box the tool tree settles in one region, or splits at a plane into two settled sides, has
+// its subtree walked by that answer (walk_settled, walk_split) with no further walk of the tool tree.
 // Iterative: two fixed stacks as deep as the loader allows trees to be (one for the nodes not
 // settled by an ancestor, one for a settled subtree's), and a budget of the tree's node count
 // for the nodes and the leaves taken whole, so tables the loader would refuse cannot make it loop.
