@@ -94,27 +94,37 @@ constexpr double kShortestTimedAlone_us = 1.0;
 constexpr double kBatchLength_us = 2.0;
 constexpr std::size_t kCalibrationBatch = 100;
 
+// One sample: `runs` runs of `work` back to back, their mean in microseconds.
+template <typename Work>
+double time_batch(Work&& work, std::size_t runs) {
+  const auto begin = Clock::now();
+  for (std::size_t run = 0; run < runs; ++run) {
+    work();
+  }
+  const auto end = Clock::now();
+  return std::chrono::duration<double, std::micro>(end - begin).count() / static_cast<double>(runs);
+}
+
+// The median, 99.9th percentile and maximum of the samples (sorted here).
+Timing timing_of(std::vector<double>& samples, std::size_t batch) {
+  std::sort(samples.begin(), samples.end());
+  const std::size_t n = samples.size();
+  const std::size_t p999 = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.999 * static_cast<double>(n))) - 1);
+  return {samples[n / 2], samples[p999], samples.back(), n, batch};
+}
+
 // Times `work` up to `iterations` samples or `budget_s` seconds (at least 11 samples), and gives
 // their median, 99.9th percentile and maximum in microseconds per run. Work under
 // kShortestTimedAlone_us (by the median of eleven runs timed alone) is run back to back in batches
 // of about kBatchLength_us (sized from eleven batches of kCalibrationBatch runs, whose clock reads
 // are a small part), each sample the batch's mean: the percentiles are then of batch means, which
-// smooth a single run's tail. batch > 0 takes that many runs per sample instead (a baseline timed
-// as its cycle was).
+// smooth a single run's tail. batch > 0 takes that many runs per sample instead.
 template <typename Work>
 Timing measure(Work&& work, std::size_t iterations, double budget_s, std::size_t batch = 0) {
-  const auto time_batch = [&](std::size_t runs) {
-    const auto begin = Clock::now();
-    for (std::size_t run = 0; run < runs; ++run) {
-      work();
-    }
-    const auto end = Clock::now();
-    return std::chrono::duration<double, std::micro>(end - begin).count() / static_cast<double>(runs);
-  };
   const auto median_of_eleven = [&](std::size_t runs) {
     std::array<double, 11> means{};
     for (double& mean : means) {
-      mean = time_batch(runs);
+      mean = time_batch(work, runs);
     }
     std::nth_element(means.begin(), means.begin() + means.size() / 2, means.end());
     return means[means.size() / 2];
@@ -130,15 +140,66 @@ Timing measure(Work&& work, std::size_t iterations, double budget_s, std::size_t
   samples.reserve(iterations);
   const auto started = Clock::now();
   for (std::size_t i = 0; i < iterations; ++i) {
-    samples.push_back(time_batch(batch));
+    samples.push_back(time_batch(work, batch));
     if (i >= 10 && std::chrono::duration<double>(Clock::now() - started).count() > budget_s) {
       break;
     }
   }
-  std::sort(samples.begin(), samples.end());
-  const std::size_t n = samples.size();
-  const std::size_t p999 = std::min(n - 1, static_cast<std::size_t>(std::ceil(0.999 * static_cast<double>(n))) - 1);
-  return {samples[n / 2], samples[p999], samples.back(), n, batch};
+  return timing_of(samples, batch);
+}
+
+volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
+
+// The machine's own tail at a given length of work: a fixed chain of dependent arithmetic. On a
+// shared or virtual machine the 99.9th percentile of any work of tens of microseconds is inflated
+// by interrupts and by the host taking the CPU away; a baseline as long as a cycle, in the same
+// run, shows how much of a measured tail is the machine's rather than the code's.
+void baseline_chain(std::size_t steps) {
+  double value = sink;
+  for (std::size_t i = 0; i < steps; ++i) {
+    value = value * 0.999999 + 1e-9;
+  }
+  sink = value;
+}
+
+// The chain's steps for a median of `median_us`, calibrated on the median of short runs.
+std::size_t baseline_steps(double median_us) {
+  std::size_t steps = 1000;
+  for (int round = 0; round < 3; ++round) {
+    const Timing t = measure([&] { baseline_chain(steps); }, 200, 0.5);
+    steps = std::max<std::size_t>(1, static_cast<std::size_t>(static_cast<double>(steps) * median_us / t.median_us));
+  }
+  return steps;
+}
+
+// A cycle and its baseline row: the baseline sized to the cycle's median (from a first 500
+// samples of it), then the two sampled in turn, a cycle's sample then a baseline's, up to
+// `iterations` each or `budget_s` seconds, `batch` runs to a sample for both. In turn, so that
+// both rows meet the same stretches of the machine's noise: timed one after the other, a burst of
+// the host's load during one row but not the other moved the ratio of their tails from 0.9 to 1.8
+// between runs of the same build.
+struct TimedBeside {
+  Timing work;
+  Timing baseline;
+};
+template <typename Work>
+TimedBeside measure_beside_baseline(Work&& work, std::size_t iterations, double budget_s) {
+  const Timing first = measure(work, 500, 0.5);
+  const std::size_t steps = baseline_steps(first.median_us);
+  const std::size_t batch = first.batch;
+  std::vector<double> ours;
+  std::vector<double> theirs;
+  ours.reserve(iterations);
+  theirs.reserve(iterations);
+  const auto started = Clock::now();
+  for (std::size_t i = 0; i < iterations; ++i) {
+    ours.push_back(time_batch(work, batch));
+    theirs.push_back(time_batch([&] { baseline_chain(steps); }, batch));
+    if (i >= 10 && std::chrono::duration<double>(Clock::now() - started).count() > budget_s) {
+      break;
+    }
+  }
+  return {timing_of(ours, batch), timing_of(theirs, batch)};
 }
 
 struct State {
@@ -157,30 +218,6 @@ std::size_t brute_force(const tables::PartTables& part, const Eigen::Vector3d& t
   }
   return penetrating;
 }
-
-volatile double sink = 0.0;  // keeps the optimiser from dropping measured work
-
-// The machine's own tail at a given length of work: a fixed chain of dependent arithmetic, as long
-// as `median_us`, timed the same way (`batch` runs to a sample, as its cycle). On a shared or
-// virtual machine the 99.9th percentile of any work of tens of microseconds is inflated by
-// interrupts and by the host taking the CPU away; this row, in the same run, shows how much of a
-// measured tail is the machine's rather than the code's.
-Timing baseline_of_length(double median_us, std::size_t batch) {
-  const auto chain = [](std::size_t steps) {
-    double value = sink;
-    for (std::size_t i = 0; i < steps; ++i) {
-      value = value * 0.999999 + 1e-9;
-    }
-    sink = value;
-  };
-  std::size_t steps = 1000;
-  for (int round = 0; round < 3; ++round) {  // calibrate on the median of short runs
-    const Timing t = measure([&] { chain(steps); }, 200, 0.5);
-    steps = std::max<std::size_t>(1, static_cast<std::size_t>(static_cast<double>(steps) * median_us / t.median_us));
-  }
-  return measure([&] { chain(steps); }, 5000, 2.0, batch);
-}
-
 
 struct Options {
   bool json = false;
@@ -473,23 +510,23 @@ void state_rows(const Options& options, const tables::PartTables& part, const be
   const Timing query =
       measure([&] { sink = sink + engine::query_contacts(part, pose, parameters).max_depth_mm; }, 5000, 2.0);
   emit("stencil", "query", query, count);
-  const Timing cycle = measure(
+  const TimedBeside cycle = measure_beside_baseline(
       [&] {
         engine::VirtualTool tool(part, state.resting);
         const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
         const engine::RemediationResult result = tool.step(state.desired, contact, parameters);
         sink = sink + contact.max_depth_mm + result.tip_mm.z();
       },
-      5000, 2.0);
-  emit("stencil", "cycle", cycle, {});
-  emit("baseline", "cycle", baseline_of_length(cycle.median_us, cycle.batch), {});
+      5000, 4.0);
+  emit("stencil", "cycle", cycle.work, {});
+  emit("baseline", "cycle", cycle.baseline, {});
 #if !defined(STENCIL_BENCH_PREVIOUS)
   // The same cycle with the wall's feel on (issue 29), on its longest path as Controller::move_tool
   // and wall_damping take it: the friction cone (a coefficient low enough that a tool resting on
   // the part slides), the probe under the resting tool and the query at the friction's goal, then
   // the velocity filters, the damper, the passivity observer and controller, the speed penalty
   // (its velocity predictor left out: a few multiplications), and the force.
-  const Timing felt = measure(
+  const TimedBeside felt = measure_beside_baseline(
       [&] {
         engine::VirtualTool tool(part, state.resting);
         const engine::ContactResult contact = engine::query_contacts(part, pose, parameters);
@@ -523,9 +560,9 @@ void state_rows(const Options& options, const tables::PartTables& part, const be
             engine::haptic_output(state.desired, result.tip_mm, contact, engine::HapticLimits{}, added);
         sink = sink + contact.max_depth_mm + result.tip_mm.z() + out.force_n.x();
       },
-      5000, 2.0);
-  emit("stencil+feel", "cycle", felt, {});
-  emit("baseline", "cycle", baseline_of_length(felt.median_us, felt.batch), {});
+      5000, 4.0);
+  emit("stencil+feel", "cycle", felt.work, {});
+  emit("baseline", "cycle", felt.baseline, {});
 #endif
   if (fcl == nullptr) {
     return;
@@ -598,7 +635,8 @@ constexpr const char* kUsage =
     "timed in batches of about 2 us run back to back, each sample a batch's mean: column \"batch\"\n"
     "gives the runs per sample (1: each run timed alone); such a row's p999 and max are of batch means.\n"
     "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
-    "timed the same way, so the machine's own tail can be told from the code's.\n"
+    "timed the same way and sampled in turn with it (a cycle's sample, then a baseline's), so that\n"
+    "both meet the same noise and the machine's own tail can be told from the code's.\n"
     "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
     "speed penalty), on its longest path (the probe under a resting tool and the query at the\n"
     "friction's goal).\n"
