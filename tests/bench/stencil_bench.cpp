@@ -174,7 +174,7 @@ std::size_t baseline_steps(double median_us) {
 
 // A cycle and its baseline row: the baseline sized to the cycle's median (from a first 500
 // samples of it), then the two sampled in turn, a cycle's sample then a baseline's, up to
-// `iterations` each or `budget_s` seconds, `batch` runs to a sample for both. In turn, so that
+// `iterations` each or `budget_s` seconds for the two together, `batch` runs to a sample for both. In turn, so that
 // both rows meet the same stretches of the machine's noise: timed one after the other, a burst of
 // the host's load during one row but not the other moved the ratio of their tails from 0.9 to 1.8
 // between runs of the same build.
@@ -634,9 +634,10 @@ constexpr const char* kUsage =
     "Times are in microseconds per run. Work under 1 us (a read of the clock costs tens of ns) is\n"
     "timed in batches of about 2 us run back to back, each sample a batch's mean: column \"batch\"\n"
     "gives the runs per sample (1: each run timed alone); such a row's p999 and max are of batch means.\n"
-    "After each cycle row, impl \"baseline\": a fixed arithmetic loop as long as that cycle's median,\n"
-    "timed the same way and sampled in turn with it (a cycle's sample, then a baseline's), so that\n"
-    "both meet the same noise and the machine's own tail can be told from the code's.\n"
+    "After each cycle row, impl \"baseline\": a fixed arithmetic loop sized to that cycle's median\n"
+    "(from a first 500 samples of the cycle), timed the same way and sampled in turn with it (a\n"
+    "cycle's sample, then a baseline's), so that both meet the same noise and the machine's own\n"
+    "tail can be told from the code's.\n"
     "Impl \"stencil+feel\": the cycle with the wall's feel on (friction, damping, passivity, the\n"
     "speed penalty), on its longest path (the probe under a resting tool and the query at the\n"
     "friction's goal).\n"

@@ -53,25 +53,27 @@ bool overlaps_node(const geometry::Kdop14& volume, const tables::BvhNode& node) 
 #endif
 }
 
-// Walks the points' tree for the tool at `pose`. Leaves are culled by the tool's 14-DOP and, for
-// the upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
-// end). For the upright tool each remaining leaf is taken as a whole, its points' depths and
-// escape directions computed lane-wise: from one region's surface when the leaf's box lies in that
-// region or just straddles its boundary (no walk of the tool tree per point), from the two sides'
-// regions when it straddles a partition plane, point by point through the tool tree when it
-// straddles other tests, skipped when the box is wholly outside. A leaf in one region (or in it or
-// outside), or split between two at a plane, goes bound (bind_leaf) to visit_region_leaf(cover,
-// leaf), which loads and settles its lanes itself (the query computes its force in the same pass) and answers a
-// LeafVisit; a mixed one goes settled to visit_leaf. For any other axis each point goes through classify_at_pose and
-// visit_point(index, classification) gets those in the tool or on its surface (and the leaf's
-// block, for its normal). visit_point and visit_leaf stop the walk by returning false. When only
-// penetrating points are wanted, a leaf whose box lies wholly deeper than the tolerance in one
-// region, and every leaf under a node whose box does, goes first to visit_deep_leaf (below); a node
-// whose box the tool tree settles in one region, or splits at a plane into two settled sides, has
-// its subtree walked by that answer (walk_settled, walk_split) with no further walk of the tool tree.
-// Iterative: two fixed stacks as deep as the loader allows trees to be (one for the nodes not
-// settled by an ancestor, one for a settled subtree's), and a budget of the tree's node count
-// for the nodes and the leaves taken whole, so tables the loader would refuse cannot make it loop.
+// Walks the points' tree for the tool at `pose`. Nodes are culled by the tool's 14-DOP and, for the
+// upright tool of the 3-axis mill, by its outline (the envelope's DOP is loose around a ball's
+// end), except under a node the tool tree settles (walk_settled culls by depth alone). For the
+// upright tool each remaining leaf is taken as a whole, its points' depths and escape directions
+// computed lane-wise: from one region's surface when the leaf's box lies in that region or just
+// straddles its boundary (no walk of the tool tree per point), from the two sides' regions when it
+// straddles a partition plane, point by point through the tool tree when it straddles other tests,
+// skipped when the box is wholly outside. A leaf in one region (or in it or outside), or split
+// between two at a plane, goes bound (bind_leaf) to visit_region_leaf(cover, leaf), which loads and
+// settles its lanes itself (the query computes its force in the same pass) and answers a LeafVisit;
+// a mixed one goes settled to visit_leaf. For any other axis each point goes through
+// classify_at_pose and visit_point(index, classification) gets those in the tool or on its surface
+// (and the leaf's block, for its normal). visit_point and visit_leaf stop the walk by returning
+// false. When only penetrating points are wanted, a leaf whose box lies wholly deeper than the
+// tolerance in one region, and every leaf under a node whose box does, goes first to
+// visit_deep_leaf (below); a node whose box the tool tree settles in one region, or splits at a
+// plane into two settled sides, has its subtree walked by that answer (walk_settled, walk_split)
+// with no further walk of the tool tree. Iterative: fixed stacks as deep as the loader allows trees
+// to be (one for the nodes not settled by an ancestor, one for a split subtree's, one for a settled
+// subtree's), and a budget of the tree's node count for the nodes and the leaves taken whole, so
+// tables the loader would refuse cannot make it loop.
 enum class Wanted : std::uint8_t {
   Penetrating,  // only points deeper than the tolerance matter (force, legality)
   InTool,       // points on the surface matter too (touched triangles)
@@ -299,17 +301,18 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
   };
   // The subtree under node `root` (its children, not itself), whose box straddles the tool tree's
   // partition plane z = split.split_z_mm with each side settled (split.below, split.above). A box
-  // inside the root's (the loader's DOP check) with its points on one side only is settled as
-  // that side says, by the same argument as walk_settled's: each point below the plane reaches the
+  // inside the root's (the loader's DOP check) with its points on one side only is settled as that
+  // side says, by the same argument as walk_settled's: each point below the plane reaches the
   // region `below` names for the whole root box (or is outside the tool, its depth there below the
   // tolerance), and likewise above. So such a node and all under it go to walk_settled, and a node
   // still across the plane keeps the root's two sides: a leaf goes to visit_region_leaf with the
-  // root's cover (the same lanes on the same surfaces; its depth bound is the root's, larger, which
-  // only asks for a search of its deepest lane that finds the same point), and the walk goes into
-  // the others. The plane test is classify_meridian's (BelowPartition: z - split < 0 below, on the
-  // box's lowest or highest z). Classifying each of these nodes from the tree's root gave the same
-  // verdicts, depths and forces in the same order, at about 250 instructions a node; most of the
-  // deep corner's boxes met the plane of a ball's centre.
+  // root's cover, less any side it is shallow on (below), the lanes' verdicts the same; its depth
+  // bound is the root's, larger, which only asks for a search of its deepest lane that finds the
+  // same point; the walk goes into the others. The plane test is classify_meridian's
+  // (BelowPartition: z - split < 0 below, on the box's lowest or highest z). Classifying each of
+  // these nodes from the tree's root gave the same verdicts, depths and forces in the same order,
+  // at about 250 instructions a node; most of the deep corner's boxes met the plane of a ball's
+  // centre.
   const auto walk_split = [&](std::uint32_t root, const tables::BvhNode& root_node,
                               const geometry::BoxClassification& split) {
     // Each settled side's depths: a box shallower on a side has no penetrating point there (none
@@ -357,7 +360,7 @@ Walk walk_points_in_tool(const tables::PartTables& part, const geometry::ToolBsp
         return Walk::BadTree;
       }
       if (!(below_low < 0.0)) {
-        return Walk::BadTree;  // not finite: a box or tip the loader and the query would have refused
+        return Walk::BadTree;  // a NaN low z across the plane: a box the loader would have refused
       }
       if (!overlaps_node(volume, node)) {
         continue;
