@@ -4,11 +4,14 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "firmware/core/geometry/meridian_box.hpp"
 #include "firmware/core/stencil/contact_query.hpp"
+#include "firmware/core/stencil/leaf_contacts.hpp"
 #include "firmware/core/tables/table_loader.hpp"
 #include "tests/support/sample_tables.hpp"
 #include "toolchain/tablegen/tool_option.hpp"
@@ -428,4 +431,119 @@ TEST(ContactQueryOracle, ABallDeepInAFaceFindsItsDeepestPointInALeafSettledFromI
   LONGS_EQUAL(count, result.penetrating_points);
   DOUBLES_EQUAL(deepest, result.max_depth_mm, 0.0);
   LONGS_EQUAL(first_deepest, result.deepest_point);
+}
+
+namespace {
+
+// The walk's force and torque sums, without its walk: every leaf's box classified from the tool
+// tree's root on its own, in the leaves' order (the walk's), each leaf's share computed as the
+// walk computes it for that classification: from its moments where its box lies wholly deeper than
+// the tolerance in one region and they settle it, else lane by lane (in one region, split at a
+// plane, or point by point). What the walk settles for whole subtrees (walk_settled, walk_split,
+// a wholly deep run) must give these bits exactly. `kinds` counts the leaves per classification.
+struct LeafByLeaf {
+  Eigen::Vector3d force = Eigen::Vector3d::Zero();
+  Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+  int split = 0;
+  int deep = 0;
+};
+LeafByLeaf leaf_by_leaf_sums(const tables::PartTables& part, const Eigen::Vector3d& tip, const ContactParameters& parameters) {
+  const double k_world = parameters.stiffness_n_per_device_mm * parameters.device_mm_per_world_mm;
+  const double height = parameters.compliance_centre_mm;
+  const Eigen::Vector3d centre = tip + height * Eigen::Vector3d::UnitZ();
+  const LeafTip split_tip = leaf_tip(tip);
+  LeafByLeaf sums;
+  LeafContacts leaf;
+  for (std::uint32_t index = 0; index < part.node_count(); ++index) {
+    const tables::BvhNode& node = part.nodes[index];
+    if (node.point_count == 0) {
+      continue;
+    }
+    const tables::LeafBlock& block = part.leaves[node.leaf];
+    const Eigen::Vector3d low(node.dop_min[0], node.dop_min[1], node.dop_min[2]);
+    const Eigen::Vector3d high(node.dop_max[0], node.dop_max[1], node.dop_max[2]);
+    const geometry::MeridianBox box = geometry::upright_meridian_box(tip, low, high);
+    const geometry::BoxClassification cover = geometry::classify_meridian_box(part.tool, box);
+    bind_leaf(part, block, split_tip, leaf);
+    RegionLeafForce share{};
+    switch (cover.cover) {
+      case geometry::BoxCover::Outside:
+        continue;
+      case geometry::BoxCover::Region:
+      case geometry::BoxCover::RegionOrOutside: {
+        if (geometry::region_depth_range(part.tool, cover.region, box).shallowest_mm > geometry::kSurfaceTolerance_mm) {
+          const geometry::ImplicitSurface& surface = part.tool.surfaces[part.tool.regions[cover.region].surface];
+          const LeafMomentForce moment = leaf_moment_force(surface, block, tip, centre, k_world);
+          if (moment.settled) {
+            sums.force += moment.force;
+            sums.torque += moment.torque;
+            ++sums.deep;
+            continue;
+          }
+        }
+        CHECK(region_leaf_force(part.tool, cover.region, cover.cover == geometry::BoxCover::RegionOrOutside, false,
+                                k_world, height, leaf, share));
+        break;
+      }
+      case geometry::BoxCover::SplitAtZ:
+        CHECK(split_leaf_force(part.tool, cover, false, k_world, height, leaf, share));
+        ++sums.split;
+        break;
+      case geometry::BoxCover::Mixed:
+        load_lanes(leaf);
+        CHECK(mixed_leaf_contacts(part.tool, leaf));
+        share.penetrating = leaf.penetrating;
+        share.sums = leaf_forces(leaf, k_world, height);
+        break;
+    }
+    if (share.penetrating > 0) {
+      sums.force += share.sums.force;
+      sums.torque += share.sums.torque;
+    }
+  }
+  return sums;
+}
+
+}  // namespace
+
+// The walk settles whole subtrees without the tool tree: below a node in one region by that
+// region's depth alone, below a node across a partition plane (a ball's centre, a bull nose's
+// corner top) by its two sides. Each of those is a shortcut to what classifying every leaf's box
+// from the tool tree's root gives, so the force and torque must be those bits exactly, not merely
+// as near as the lanes' rounding: the tips below put the planes across the faces and the tools
+// deep into them.
+TEST(ContactQueryOracle, SubtreesSettledWholeGiveTheBitsOfEveryLeafClassifiedOnItsOwn) {
+  std::mt19937_64 random(909);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (const char* tool_text : {"ball:d=3", "bull:d=4,r=1", "flat:d=3"}) {
+    const tablegen::TableBytes bytes = table_at_spacing(tool_text, 0.05);
+    tables::PartTables part{};
+    CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
+    const ContactParameters parameters{};
+    const double k_world = parameters.stiffness_n_per_device_mm * parameters.device_mm_per_world_mm;
+    int in_contact = 0;
+    int with_split_leaves = 0;
+    int with_deep_leaves = 0;
+    for (int trial = 0; trial < 120; ++trial) {
+      const double angle = 3.14159265358979323846 * unit(random);
+      const double radius = kApothem_mm + 1.2 * unit(random);
+      const double height = trial % 2 == 0 ? kTop_mm - 0.4 + 0.5 * unit(random) : 3.0 + 2.5 * unit(random);
+      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle), height);
+      const ContactResult result = query_contacts(part, upright_at(tip.x(), tip.y(), tip.z()), parameters);
+      CHECK(result.status == QueryStatus::Ok);
+      const LeafByLeaf expected = leaf_by_leaf_sums(part, tip, parameters);
+      const double magnitude = expected.force.norm();
+      const double scale = magnitude > 0.0 ? k_world * result.max_depth_mm / magnitude : 0.0;
+      const Eigen::Vector3d force = magnitude > 0.0 ? Eigen::Vector3d(scale * expected.force) : Eigen::Vector3d::Zero();
+      const Eigen::Vector3d torque = magnitude > 0.0 ? Eigen::Vector3d(scale * expected.torque) : Eigen::Vector3d::Zero();
+      CHECK_TEXT(result.force_n == force && result.torque_nmm == torque, tool_text);
+      in_contact += result.penetrating_points > 0 ? 1 : 0;
+      with_split_leaves += result.penetrating_points > 0 && expected.split > 0 ? 1 : 0;
+      with_deep_leaves += expected.deep > 0 ? 1 : 0;
+    }
+    CHECK_TEXT(in_contact > 40, tool_text);
+    // Not idle: planes across the contact (no flat end has one) and leaves settled whole.
+    CHECK_TEXT(std::string(tool_text).rfind("flat", 0) == 0 || with_split_leaves > 10, tool_text);
+    CHECK_TEXT(with_deep_leaves > 10, tool_text);
+  }
 }
