@@ -440,7 +440,8 @@ namespace {
 // walk computes it for that classification: from its moments where its box lies wholly deeper than
 // the tolerance in one region and they settle it, else lane by lane (in one region, split at a
 // plane, or point by point). What the walk settles for whole subtrees (walk_settled, walk_split,
-// a wholly deep run) must give these bits exactly. `kinds` counts the leaves per classification.
+// a wholly deep run) must give these bits exactly. `split` and `deep` count the leaves split at a
+// plane and those settled from their moments.
 struct LeafByLeaf {
   Eigen::Vector3d force = Eigen::Vector3d::Zero();
   Eigen::Vector3d torque = Eigen::Vector3d::Zero();
