@@ -50,6 +50,18 @@ tablegen::TableBytes table_at_spacing(const char* tool_text, double spacing_mm) 
   return test::make_table(test::default_part(), options);
 }
 
+// A tip within `across` mm of the prism's side faces and edges (either side of the apothem), on
+// even trials within `spread` mm of `top` (near the top face), on odd ones 0.5-5.5 mm up (low
+// beside the side faces, so that the tool's partition planes, a ball's equator or a bull nose's
+// corner top, cross the faces).
+Eigen::Vector3d tip_near_the_faces(std::mt19937_64& random, int trial, double across, double top, double spread) {
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const double angle = 3.14159265358979323846 * unit(random);
+  const double radius = kApothem_mm + across * unit(random);
+  const double height = trial % 2 == 0 ? top + spread * unit(random) : 3.0 + 2.5 * unit(random);
+  return {25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle), height};
+}
+
 }  // namespace
 
 TEST_GROUP(ContactQuery) {
@@ -239,7 +251,6 @@ TEST_GROUP(ContactQueryOracle){};
 // degree, its torque per newton within 0.05 mm.
 TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
   std::mt19937_64 random(404);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (const char* tool_text : {"ball:d=3", "flat:d=3", "bull:d=4,r=1"}) {
     const tablegen::TableBytes bytes = table_at_spacing(tool_text, 0.08);
     tables::PartTables part{};
@@ -258,10 +269,7 @@ TEST(ContactQueryOracle, LeafByLeafAgreesWithEveryPointThroughTheToolTree) {
       // Tips near the top face, the side faces and the prism's edges, up to 0.6 mm into the part,
       // and low beside the side faces so that the tool's partition planes (a ball's equator, a
       // bull-nose's corner top) cross the faces.
-      const double angle = 3.14159265358979323846 * unit(random);
-      const double radius = kApothem_mm + 1.6 * unit(random);
-      const double height = trial % 2 == 0 ? kTop_mm - 0.3 + 0.9 * unit(random) : 3.0 + 2.5 * unit(random);
-      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle), height);
+      const Eigen::Vector3d tip = tip_near_the_faces(random, trial, 1.6, kTop_mm - 0.3, 0.9);
       const ToolPose pose = upright_at(tip.x(), tip.y(), tip.z());
       std::uint32_t count = 0;
       double deepest = 0.0;
@@ -514,22 +522,18 @@ LeafByLeaf leaf_by_leaf_sums(const tables::PartTables& part, const Eigen::Vector
 // as near as the lanes' rounding: the tips below put the planes across the faces and the tools
 // deep into them.
 TEST(ContactQueryOracle, SubtreesSettledWholeGiveTheBitsOfEveryLeafClassifiedOnItsOwn) {
+  const ContactParameters parameters{};
+  const double k_world = parameters.stiffness_n_per_device_mm * parameters.device_mm_per_world_mm;
   std::mt19937_64 random(909);
-  std::uniform_real_distribution<double> unit(-1.0, 1.0);
   for (const char* tool_text : {"ball:d=3", "bull:d=4,r=1", "flat:d=3"}) {
+    int in_contact = 0;
     const tablegen::TableBytes bytes = table_at_spacing(tool_text, 0.05);
     tables::PartTables part{};
     CHECK(tables::load_tables({bytes.data(), bytes.size()}, part).ok);
-    const ContactParameters parameters{};
-    const double k_world = parameters.stiffness_n_per_device_mm * parameters.device_mm_per_world_mm;
-    int in_contact = 0;
     int with_split_leaves = 0;
     int with_deep_leaves = 0;
     for (int trial = 0; trial < 120; ++trial) {
-      const double angle = 3.14159265358979323846 * unit(random);
-      const double radius = kApothem_mm + 1.2 * unit(random);
-      const double height = trial % 2 == 0 ? kTop_mm - 0.4 + 0.5 * unit(random) : 3.0 + 2.5 * unit(random);
-      const Eigen::Vector3d tip(25.0 + radius * std::cos(angle), 12.5 + radius * std::sin(angle), height);
+      const Eigen::Vector3d tip = tip_near_the_faces(random, trial, 1.2, kTop_mm - 0.4, 0.5);
       const ContactResult result = query_contacts(part, upright_at(tip.x(), tip.y(), tip.z()), parameters);
       CHECK(result.status == QueryStatus::Ok);
       const LeafByLeaf expected = leaf_by_leaf_sums(part, tip, parameters);
